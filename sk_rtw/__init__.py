@@ -1,0 +1,34 @@
+"""sk_rtw: Riemannian Time Warping for scikit-learn.
+
+Align, average and classify time series whose samples live on Riemannian manifolds.
+"""
+
+from .dtw import dtw_cost_matrix, dtw_distance, dtw_pairwise_distance, dtw_path
+from .manifolds import (
+    SPD,
+    Euclidean,
+    Manifold,
+    Product,
+    Quaternion,
+    Sphere,
+    available_manifolds,
+    get_manifold,
+)
+
+__version__ = "0.1.0.dev0"
+
+__all__ = [
+    "SPD",
+    "Euclidean",
+    "Manifold",
+    "Product",
+    "Quaternion",
+    "Sphere",
+    "__version__",
+    "available_manifolds",
+    "dtw_cost_matrix",
+    "dtw_distance",
+    "dtw_pairwise_distance",
+    "dtw_path",
+    "get_manifold",
+]

@@ -1,0 +1,258 @@
+"""Numba kernels: the DTW recursion over a cost matrix, band, backtracking, cost matrices.
+
+The recursion ``D[i, j] = C[i, j] + min(D[i-1, j], D[i, j-1], D[i-1, j-1])`` is written
+once (:func:`_accumulate_row`) and used by every public function. ``fastmath`` is never
+enabled: the band uses ``inf`` for forbidden cells.
+
+Point distances that numba computes itself are described by "segments" ``(start, stop,
+code)`` of a flattened point (see :attr:`sk_rtw.manifolds.Manifold.numba_segments`):
+code 0 Euclidean, 1 great-circle on a sphere, 2 sign-invariant great circle (quaternions);
+a product space is several segments, combined as ``sqrt(sum d_s^2)``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+_INF = np.inf
+
+
+@njit(cache=True)
+def sakoe_chiba_rows(nx: int, ny: int, window: float):
+    """Allowed column range ``[lo[i], hi[i])`` of each row of an ``nx x ny`` DTW matrix.
+
+    ``window`` is the band radius as a fraction of the shorter series (aeon's convention);
+    a negative value means no band.
+    """
+    lo = np.zeros(nx, dtype=np.int64)
+    hi = np.full(nx, ny, dtype=np.int64)
+    if window < 0.0 or window >= 1.0:
+        return lo, hi
+    lo[:] = ny
+    hi[:] = 0
+    transpose = nx > ny
+    a, b = (ny, nx) if transpose else (nx, ny)
+    steps = max(a, b) + 1
+    thickness = int(window * min(a, b))
+    for step in range(steps):
+        ai = math.floor(step / steps * a)
+        bi = math.floor(step / steps * b)
+        start = max(0, ai - thickness)
+        stop = min(a, ai + thickness + 1)
+        for r in range(start, stop):
+            # cell (r, bi) of the a x b matrix is allowed
+            i, j = (bi, r) if transpose else (r, bi)
+            if j < lo[i]:
+                lo[i] = j
+            if j + 1 > hi[i]:
+                hi[i] = j + 1
+    return lo, hi
+
+
+@njit(cache=True, inline="always")
+def _accumulate_row(cost_row, prev, cur, i, lo, hi, ny):
+    """Fill row ``i`` of the accumulated cost from row ``i - 1``.
+
+    ``prev`` and ``cur`` are padded rows of length ``ny + 1``: entry ``j + 1`` holds column
+    ``j`` and entry 0 is the ``inf`` (or, before row 0, zero) sentinel. Only columns in
+    ``[lo, hi)`` are allowed; the others are set to ``inf``.
+    """
+    cur[0] = _INF
+    for j in range(1, lo + 1):
+        cur[j] = _INF
+    left = _INF
+    for j in range(lo, hi):
+        best = prev[j]
+        if prev[j + 1] < best:
+            best = prev[j + 1]
+        if left < best:
+            best = left
+        left = cost_row[j] + best
+        cur[j + 1] = left
+    for j in range(hi + 1, ny + 1):
+        cur[j] = _INF
+
+
+@njit(cache=True, inline="always")
+def _first_prev(ny):
+    """The row "before" row 0: zero at the sentinel, ``inf`` elsewhere."""
+    prev = np.full(ny + 1, _INF)
+    prev[0] = 0.0
+    return prev
+
+
+@njit(cache=True)
+def accumulated_cost(cost: np.ndarray, window: float) -> np.ndarray:
+    """Full accumulated cost matrix ``D`` (``inf`` outside the band)."""
+    nx, ny = cost.shape
+    lo, hi = sakoe_chiba_rows(nx, ny, window)
+    D = np.empty((nx, ny + 1))
+    prev = _first_prev(ny)
+    for i in range(nx):
+        _accumulate_row(cost[i], prev, D[i], i, lo[i], hi[i], ny)
+        prev = D[i]
+    return D[:, 1:].copy()
+
+
+@njit(cache=True)
+def final_cost(cost: np.ndarray, nx: int, ny: int, window: float) -> float:
+    """DTW distance over the top-left ``nx x ny`` block of ``cost`` (two rows of memory)."""
+    lo, hi = sakoe_chiba_rows(nx, ny, window)
+    prev = _first_prev(ny)
+    cur = np.empty(ny + 1)
+    for i in range(nx):
+        _accumulate_row(cost[i], prev, cur, i, lo[i], hi[i], ny)
+        prev, cur = cur, prev
+    return prev[ny]
+
+
+@njit(cache=True)
+def path_length(D: np.ndarray) -> int:
+    """Number of steps of the optimal path encoded in an accumulated cost matrix."""
+    i, j = D.shape[0] - 1, D.shape[1] - 1
+    steps = 1
+    while i > 0 or j > 0:
+        if i == 0:
+            j -= 1
+        elif j == 0:
+            i -= 1
+        else:
+            diag, up, left = D[i - 1, j - 1], D[i - 1, j], D[i, j - 1]
+            if diag <= up and diag <= left:
+                i -= 1
+                j -= 1
+            elif up <= left:
+                i -= 1
+            else:
+                j -= 1
+        steps += 1
+    return steps
+
+
+@njit(cache=True, parallel=True)
+def final_cost_batch(costs, nxs, nys, window, per_step):
+    """:func:`final_cost` for a stack of cost matrices, in parallel.
+
+    With ``per_step`` the distance is divided by the length of the optimal path.
+    """
+    n = costs.shape[0]
+    values = np.empty(n)
+    for k in prange(n):
+        if per_step:
+            D = accumulated_cost(costs[k, : nxs[k], : nys[k]], window)
+            values[k] = D[-1, -1] / path_length(D)
+        else:
+            values[k] = final_cost(costs[k], nxs[k], nys[k], window)
+    return values
+
+
+@njit(cache=True)
+def backtrack(D: np.ndarray):
+    """Optimal warping path (list of index pairs) from an accumulated cost matrix."""
+    i, j = D.shape[0] - 1, D.shape[1] - 1
+    path = [(i, j)]
+    while i > 0 or j > 0:
+        if i == 0:
+            j -= 1
+        elif j == 0:
+            i -= 1
+        else:
+            diag, up, left = D[i - 1, j - 1], D[i - 1, j], D[i, j - 1]
+            if diag <= up and diag <= left:
+                i -= 1
+                j -= 1
+            elif up <= left:
+                i -= 1
+            else:
+                j -= 1
+        path.append((i, j))
+    path.reverse()
+    return path
+
+
+@njit(cache=True, inline="always")
+def _cost_row(x, y, i, ny, segments, squared, row):
+    """Row ``i`` of the cost matrix: point costs between ``x[i]`` and ``y[:ny]``."""
+    xi = x[i]
+    n_segments = segments.shape[0]
+    for j in range(ny):
+        row[j] = 0.0
+    for s in range(n_segments):
+        start, stop, code = segments[s, 0], segments[s, 1], segments[s, 2]
+        if code == 0 and stop - start == 1:
+            a = xi[start]
+            for j in range(ny):
+                diff = a - y[j, start]
+                row[j] += diff * diff
+        elif code == 0:
+            for j in range(ny):
+                sq = 0.0
+                for k in range(start, stop):
+                    diff = xi[k] - y[j, k]
+                    sq += diff * diff
+                row[j] += sq
+        else:
+            for j in range(ny):
+                dot = 0.0
+                for k in range(start, stop):
+                    dot += xi[k] * y[j, k]
+                perp = 0.0
+                for k in range(start, stop):
+                    r = y[j, k] - dot * xi[k]
+                    perp += r * r
+                angle = math.atan2(math.sqrt(perp), abs(dot) if code == 2 else dot)
+                row[j] += angle * angle
+    if not squared:
+        for j in range(ny):
+            row[j] = math.sqrt(row[j])
+
+
+@njit(cache=True)
+def segment_cost_matrix(x, y, nx, ny, segments, squared, out):
+    """Cost matrix of flattened series ``x`` (Tx, p) and ``y`` (Ty, p) into ``out``."""
+    for i in range(nx):
+        _cost_row(x, y, i, ny, segments, squared, out[i])
+
+
+@njit(cache=True, parallel=True)
+def segment_cost_stack(x, Y, nx, nys, segments, squared):
+    """Cost matrices between ``x`` and each series of ``Y``, shape (len(Y), Tx, Ty)."""
+    out = np.zeros((Y.shape[0], x.shape[0], Y.shape[1]))
+    for k in prange(Y.shape[0]):
+        segment_cost_matrix(x, Y[k], nx, nys[k], segments, squared, out[k])
+    return out
+
+
+@njit(cache=True, parallel=True)
+def pairwise_segments(X, lx, Y, ly, segments, squared, window, symmetric):
+    """DTW between every series of ``X`` and of ``Y``, the cost rows computed in numba.
+
+    Each cost row is computed just before the recursion consumes it, so the cost matrix
+    never leaves the cache. Returns the distances, shape ``(len(X), len(Y))``.
+    """
+    n, m = X.shape[0], Y.shape[0]
+    values = np.zeros((n, m))
+    ty = Y.shape[1]
+    for k in prange(n * m):
+        i = k // m
+        j = k - i * m
+        if symmetric and j <= i:
+            continue
+        nx, ny = lx[i], ly[j]
+        lo, hi = sakoe_chiba_rows(nx, ny, window)
+        row = np.empty(ty)
+        prev = _first_prev(ny)
+        cur = np.empty(ny + 1)
+        for r in range(nx):
+            _cost_row(X[i], Y[j], r, ny, segments, squared, row)
+            _accumulate_row(row, prev, cur, r, lo[r], hi[r], ny)
+            prev, cur = cur, prev
+        values[i, j] = prev[ny]
+    if symmetric:
+        for i in range(n):
+            for j in range(i):
+                values[i, j] = values[j, i]
+    return values

@@ -1,0 +1,137 @@
+"""Cartesian products of manifolds, e.g. poses R^3 x S^3."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+
+from ._base import Manifold
+
+
+@dataclass(frozen=True)
+class Product(Manifold):
+    """Product manifold ``M_1 x ... x M_m`` with the product metric.
+
+    A point is the concatenation of the flattened factor points, so a pose
+    ``R^3 x S^3`` is 7 numbers ``(x, y, z, qw, qx, qy, qz)``. The distance is
+    ``sqrt(sum_i dist_i^2)``; ``exp`` and ``log`` act factor by factor.
+
+    Parameters
+    ----------
+    factors : tuple of Manifold
+        The factor spaces, in the order their coordinates appear.
+    """
+
+    factors: tuple[Manifold, ...] = ()
+    name = "product"
+
+    def __post_init__(self):
+        factors = tuple(self.factors)
+        if not factors or not all(isinstance(f, Manifold) for f in factors):
+            raise ValueError("Product needs a non-empty sequence of Manifold objects")
+        object.__setattr__(self, "factors", factors)
+
+    @property
+    def is_flat(self) -> bool:  # type: ignore[override]
+        return all(f.is_flat for f in self.factors)
+
+    @property
+    def _sizes(self) -> list[int]:
+        return [math.prod(f.point_shape) for f in self.factors]
+
+    @property
+    def point_shape(self) -> tuple[int, ...]:
+        return (sum(self._sizes),)
+
+    @property
+    def injectivity_radius(self) -> float:
+        return min(f.injectivity_radius for f in self.factors)
+
+    @property
+    def numba_segments(self):
+        segments, offset = [], 0
+        for factor, size in zip(self.factors, self._sizes, strict=True):
+            own = factor.numba_segments
+            if own is None:
+                return None
+            segments.extend((offset + a, offset + b, code) for a, b, code in own)
+            offset += size
+        return tuple(segments)
+
+    def _split(self, x):
+        parts = torch.split(x, self._sizes, dim=-1)
+        return [
+            part.reshape(*part.shape[:-1], *f.point_shape)
+            for part, f in zip(parts, self.factors, strict=True)
+        ]
+
+    @staticmethod
+    def _join(parts, factors):
+        return torch.cat(
+            [
+                part.reshape(*part.shape[: part.ndim - f.point_ndim], -1)
+                for part, f in zip(parts, factors, strict=True)
+            ],
+            dim=-1,
+        )
+
+    def _map(self, method: str, a, b):
+        return self._join(
+            [
+                getattr(f, method)(pa, pb)
+                for f, pa, pb in zip(self.factors, self._split(a), self._split(b), strict=True)
+            ],
+            self.factors,
+        )
+
+    def _exp(self, p, v):
+        return self._map("_exp", p, v)
+
+    def _log(self, p, x):
+        return self._map("_log", p, x)
+
+    def _combine(self, method: str, a, b):
+        squares = [
+            getattr(f, method)(pa, pb) ** 2
+            for f, pa, pb in zip(self.factors, self._split(a), self._split(b), strict=True)
+        ]
+        total = torch.stack(torch.broadcast_tensors(*squares)).sum(0)
+        positive = total > 0
+        return torch.where(positive, torch.sqrt(torch.where(positive, total, 1.0)), 0.0)
+
+    def _dist(self, p, x):
+        return self._combine("_dist", p, x)
+
+    def _norm(self, p, v):
+        return self._combine("_norm", p, v)
+
+    def _project(self, x):
+        return self._join(
+            [f._project(part) for f, part in zip(self.factors, self._split(x), strict=True)],
+            self.factors,
+        )
+
+    def _point_problems(self, x, atol):
+        problems = []
+        for i, (f, part) in enumerate(zip(self.factors, self._split(x), strict=True)):
+            problems.extend(
+                (mask, f"factor {i} ({f!r}): {text}")
+                for mask, text in f._point_problems(part, atol)
+            )
+        return problems
+
+    def _random_point(self, leading, rng):
+        parts = [f._random_point(leading, rng).reshape(*leading, -1) for f in self.factors]
+        return np.concatenate(parts, axis=-1)
+
+    def _random_tangent(self, p, scale, rng):
+        lead = p.shape[:-1]
+        parts = np.split(p, np.cumsum(self._sizes)[:-1], axis=-1)
+        out = [
+            f._random_tangent(part.reshape(*lead, *f.point_shape), scale, rng).reshape(*lead, -1)
+            for f, part in zip(self.factors, parts, strict=True)
+        ]
+        return np.concatenate(out, axis=-1)

@@ -1,0 +1,162 @@
+"""Names for manifolds, and resolution of a name against the shape of the data."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from ._base import Manifold
+from ._euclidean import Euclidean
+from ._product import Product
+from ._spd import SPD
+from ._sphere import Quaternion, Sphere
+
+
+@dataclass(frozen=True)
+class ManifoldSpec:
+    """Registry entry: how to build a manifold from a dimension or from a point shape."""
+
+    name: str
+    factory: Callable[[int | None], Manifold]
+    dim_from_point_shape: Callable[[tuple[int, ...]], int | None]
+    description: str
+    matrix_valued: bool = False
+    sign_invariant: bool = False
+    flat: bool = False
+
+
+def _euclidean_dim(shape):
+    if shape == ():
+        return 1
+    return shape[0] if len(shape) == 1 else None
+
+
+def _sphere_dim(shape):
+    return shape[0] - 1 if len(shape) == 1 and shape[0] >= 2 else None
+
+
+def _spd_dim(shape):
+    return shape[0] if len(shape) == 2 and shape[0] == shape[1] else None
+
+
+def _fixed(size):
+    return lambda shape: 0 if shape == (size,) else None
+
+
+def _pose(_dim=None) -> Product:
+    return Product((Euclidean(3), Quaternion()))
+
+
+_REGISTRY: dict[str, ManifoldSpec] = {
+    spec.name: spec
+    for spec in [
+        ManifoldSpec(
+            "euclidean",
+            lambda d: Euclidean(d),
+            _euclidean_dim,
+            "R^d; univariate series are R^1",
+            flat=True,
+        ),
+        ManifoldSpec("sphere", lambda d: Sphere(d), _sphere_dim, "unit sphere S^d in R^(d+1)"),
+        ManifoldSpec(
+            "quaternion",
+            lambda d: Quaternion(),
+            _fixed(4),
+            "unit quaternions (w, x, y, z), q ~ -q",
+            sign_invariant=True,
+        ),
+        ManifoldSpec(
+            "spd",
+            lambda d: SPD(d),
+            _spd_dim,
+            "SPD(k) matrices, affine-invariant metric",
+            matrix_valued=True,
+        ),
+        ManifoldSpec(
+            "pose",
+            _pose,
+            _fixed(7),
+            "R^3 x S^3 poses (x, y, z, qw, qx, qy, qz)",
+            sign_invariant=True,
+        ),
+    ]
+}
+_FIXED_DIMENSION = {"quaternion", "pose"}
+
+
+def available_manifolds() -> dict[str, ManifoldSpec]:
+    """The registry: manifold names mapped to their specification."""
+    return dict(_REGISTRY)
+
+
+def get_manifold(
+    manifold: str | Manifold = "euclidean",
+    dim: int | None = None,
+    *,
+    point_shape: tuple[int, ...] | None = None,
+) -> Manifold:
+    """Build (or check) a manifold from a name, a dimension and/or the data's point shape.
+
+    Parameters
+    ----------
+    manifold : str or Manifold, default="euclidean"
+        A registry name (``"euclidean"``, ``"sphere"``, ``"quaternion"``, ``"spd"``,
+        ``"pose"``) or a manifold object, which is returned unchanged after checking it
+        against ``point_shape``.
+    dim : int, optional
+        Dimension for the named space (``d`` of R^d or S^d, ``k`` of SPD(k)).
+    point_shape : tuple of int, optional
+        Shape of one point of the data at hand (``()`` for univariate series). Used to
+        infer ``dim`` when it is not given, and to check it when it is.
+
+    Returns
+    -------
+    Manifold
+
+    Examples
+    --------
+    >>> get_manifold("sphere", dim=2)
+    Sphere(dim=2)
+    >>> get_manifold("spd", point_shape=(3, 3))
+    SPD(dim=3)
+    """
+    if isinstance(manifold, Manifold):
+        if dim is not None:
+            raise ValueError("dim can only be given together with a manifold name")
+        if point_shape is not None:
+            _check_point_shape(manifold, point_shape)
+        return manifold
+    if not isinstance(manifold, str):
+        raise TypeError(
+            f"manifold must be a name or a Manifold object, got {type(manifold).__name__}"
+        )
+    key = manifold.lower()
+    if key not in _REGISTRY:
+        raise ValueError(f"unknown manifold {manifold!r}; choose one of {sorted(_REGISTRY)}")
+    spec = _REGISTRY[key]
+    if dim is None and key not in _FIXED_DIMENSION:
+        if point_shape is None:
+            raise ValueError(
+                f"manifold {manifold!r} needs a dimension: pass dim=... or data to infer it from"
+            )
+        dim = spec.dim_from_point_shape(tuple(point_shape))
+        if dim is None:
+            raise ValueError(
+                f"data with points of shape {tuple(point_shape)} do not fit manifold "
+                f"{manifold!r} ({spec.description})"
+            )
+    result = spec.factory(dim)
+    if point_shape is not None:
+        _check_point_shape(result, point_shape)
+    return result
+
+
+def _check_point_shape(manifold: Manifold, point_shape: tuple[int, ...]) -> None:
+    shape = tuple(point_shape)
+    if shape == () and manifold.point_shape == (1,):
+        return
+    if shape != manifold.point_shape:
+        raise ValueError(
+            f"data with points of shape {shape} do not fit {manifold!r}, whose points have "
+            f"shape {manifold.point_shape}"
+        )

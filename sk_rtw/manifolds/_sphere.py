@@ -1,0 +1,143 @@
+"""Unit spheres S^d and unit quaternions S^3 / {±1}."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+
+from .._backend import safe_norm
+from ._base import SEGMENT_SIGN_INVARIANT_SPHERE, SEGMENT_SPHERE, Manifold
+from ._euclidean import _check_dim
+
+# Below this squared norm the closed forms are replaced by their Taylor expansions, so
+# that values and gradients stay finite (and exact to double precision) at zero.
+_TAYLOR_SQ = 1e-12
+
+
+def _sphere_exp(p: torch.Tensor, v: torch.Tensor) -> torch.Tensor:
+    sq = (v * v).sum(-1, keepdim=True)
+    small = sq < _TAYLOR_SQ
+    safe_sq = torch.where(small, torch.ones_like(sq), sq)
+    n = torch.sqrt(safe_sq)
+    cos = torch.where(small, 1.0 - sq / 2.0 + sq * sq / 24.0, torch.cos(n))
+    sinc = torch.where(small, 1.0 - sq / 6.0 + sq * sq / 120.0, torch.sin(n) / n)
+    return cos * p + sinc * v
+
+
+def _sphere_log(p: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
+    c = (p * x).sum(-1, keepdim=True)
+    u = x - c * p
+    sq = (u * u).sum(-1, keepdim=True)
+    # theta / sin(theta) with sin(theta) = |u|, cos(theta) = c; Taylor near theta = 0.
+    small = (sq < _TAYLOR_SQ) & (c > 0)
+    safe_sq = torch.where(small, torch.ones_like(sq), sq.clamp_min(1e-300))
+    s = torch.sqrt(safe_sq)
+    factor = torch.where(small, 1.0 + sq / 6.0, torch.atan2(s, c) / s)
+    return factor * u
+
+
+def _sphere_dist(p: torch.Tensor, x: torch.Tensor, sign_invariant: bool = False) -> torch.Tensor:
+    c = (p * x).sum(-1)
+    u = x - c.unsqueeze(-1) * p
+    if sign_invariant:
+        c = c.abs()
+    return torch.atan2(safe_norm(u), c)
+
+
+@dataclass(frozen=True)
+class Sphere(Manifold):
+    """Unit sphere S^d embedded in R^(d+1), with the great-circle metric.
+
+    Parameters
+    ----------
+    dim : int, default=2
+        Intrinsic dimension ``d``; points have shape ``(d + 1,)`` (S^1: circle in R^2,
+        S^2: sphere in R^3).
+    """
+
+    dim: int = 2
+    name = "sphere"
+
+    def __post_init__(self):
+        _check_dim(self.dim, type(self).__name__, minimum=1)
+
+    @property
+    def point_shape(self) -> tuple[int, ...]:
+        return (self.dim + 1,)
+
+    @property
+    def injectivity_radius(self) -> float:
+        return math.pi
+
+    @property
+    def numba_segments(self):
+        return ((0, self.dim + 1, SEGMENT_SPHERE),)
+
+    def _exp(self, p, v):
+        return _sphere_exp(p, v)
+
+    def _log(self, p, x):
+        return _sphere_log(p, x)
+
+    def _dist(self, p, x):
+        return _sphere_dist(p, x)
+
+    def _norm(self, p, v):
+        return safe_norm(v)
+
+    def _project(self, x):
+        n = torch.linalg.vector_norm(x, dim=-1, keepdim=True)
+        if bool((n == 0).any()):
+            raise ValueError("cannot project the zero vector onto the sphere")
+        return x / n
+
+    def _point_problems(self, x, atol):
+        norm_error = (torch.linalg.vector_norm(x, dim=-1) - 1.0).abs()
+        return [(norm_error > atol, "its Euclidean norm differs from 1")]
+
+    def _random_point(self, leading, rng):
+        x = rng.standard_normal((*leading, self.dim + 1))
+        return x / np.linalg.norm(x, axis=-1, keepdims=True)
+
+    def _random_tangent(self, p, scale, rng):
+        v = scale * rng.standard_normal(p.shape)
+        return v - (v * p).sum(-1, keepdims=True) * p
+
+
+@dataclass(frozen=True)
+class Quaternion(Sphere):
+    """Unit quaternions ``(w, x, y, z)`` (w first) as orientations: S^3 with q ~ -q.
+
+    ``log`` and ``dist`` use the representative of ``x`` in the hemisphere of ``p``, so the
+    distance is invariant to ``q -> -q`` (it is half the rotation angle). Hence ``mean``
+    aligns every sample with the hemisphere of the current estimate at each Gauss–Newton
+    step, and series that flip sign between samples are interpolated without jumps.
+    """
+
+    dim: int = 3
+    name = "quaternion"
+
+    def __post_init__(self):
+        if self.dim != 3:
+            raise ValueError(f"Quaternion is S^3; dim must be 3, got {self.dim!r}")
+
+    @property
+    def injectivity_radius(self) -> float:
+        return math.pi / 2
+
+    @property
+    def numba_segments(self):
+        return ((0, 4, SEGMENT_SIGN_INVARIANT_SPHERE),)
+
+    def __repr__(self) -> str:
+        return "Quaternion()"
+
+    def _log(self, p, x):
+        sign = torch.where((p * x).sum(-1, keepdim=True) < 0, -1.0, 1.0)
+        return _sphere_log(p, sign * x)
+
+    def _dist(self, p, x):
+        return _sphere_dist(p, x, sign_invariant=True)

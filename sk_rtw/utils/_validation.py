@@ -1,0 +1,253 @@
+"""Conversion of every accepted input form to one canonical form, with clear errors.
+
+Accepted collections of series (time-major, see the input-shapes table in the docs):
+
+* ``(n_series, n_timepoints)`` -- univariate, treated as ``(n, T, 1)``;
+* ``(n, T, *point_shape)`` -- e.g. ``(n, T, d)``, ``(n, T, 4)`` quaternions,
+  ``(n, T, k, k)`` SPD matrices, ``(n, T, 7)`` poses;
+* a list of ``(T_i,)`` or ``(T_i, *point_shape)`` arrays of unequal lengths.
+
+The canonical form is a :class:`SeriesCollection`: a float64 array padded to the longest
+series by repeating each series' last sample (so padding stays on the manifold), the true
+lengths, and the manifold resolved against the data.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..manifolds import Manifold, get_manifold
+
+#: Relative tolerance used to decide whether data lie on the manifold.
+DEFAULT_ATOL = 1e-6
+
+
+@dataclass(frozen=True, eq=False)
+class SeriesCollection:
+    """Validated series: ``data`` (n, T_max, *point_shape), ``lengths`` (n,), ``manifold``."""
+
+    data: np.ndarray
+    lengths: np.ndarray
+    manifold: Manifold
+
+    @property
+    def n_series(self) -> int:
+        return self.data.shape[0]
+
+    @property
+    def max_length(self) -> int:
+        return self.data.shape[1]
+
+    @property
+    def equal_length(self) -> bool:
+        return bool(np.all(self.lengths == self.max_length))
+
+    def series(self, i: int) -> np.ndarray:
+        """The ``i``-th series without padding, shape ``(T_i, *point_shape)``."""
+        return self.data[i, : self.lengths[i]]
+
+    def to_list(self) -> list[np.ndarray]:
+        return [self.series(i) for i in range(self.n_series)]
+
+
+def _expected_layout(n_lead: int, point_shape: tuple[int, ...]) -> str:
+    lead = "(n_series, n_timepoints" if n_lead == 2 else "(n_timepoints"
+    body = ", ".join(str(s) for s in point_shape)
+    text = f"{lead}, {body})"
+    if point_shape == (1,):
+        text += f" or {lead})"
+    return text
+
+
+def _to_float_array(x: Any, name: str) -> np.ndarray:
+    if hasattr(x, "detach") and hasattr(x, "cpu"):
+        x = x.detach().cpu().numpy()
+    try:
+        arr = np.asarray(x)
+    except ValueError as exc:  # ragged nested lists
+        raise ValueError(
+            f"{name} could not be read as an array ({exc}); pass unequal-length series as a "
+            "list of arrays"
+        ) from None
+    if arr.dtype == object:
+        raise TypeError(f"{name} must contain numbers, got an object array")
+    if arr.dtype.kind not in "biuf":
+        raise TypeError(f"{name} must be numeric, got dtype {arr.dtype}")
+    return arr.astype(np.float64, copy=False)
+
+
+def check_series(
+    x: Any,
+    manifold: str | Manifold = "euclidean",
+    *,
+    name: str = "x",
+    min_length: int = 2,
+    atol: float = DEFAULT_ATOL,
+) -> tuple[np.ndarray, Manifold]:
+    """Validate one series ``(T,)`` or ``(T, *point_shape)``.
+
+    Returns
+    -------
+    series : ndarray of shape (T, *point_shape), float64
+    manifold : Manifold resolved against the data
+    """
+    arr = _to_float_array(x, name)
+    if arr.ndim == 0:
+        raise ValueError(f"{name} must be a series, got a scalar")
+    manifold_obj = _resolve(manifold, arr, n_lead=1, name=name)
+    if arr.ndim == 1 and manifold_obj.point_shape == (1,):
+        arr = arr[:, None]
+    _check_content([arr], manifold_obj, name, min_length, atol, single=True)
+    return arr, manifold_obj
+
+
+def check_series_collection(
+    X: Any,
+    manifold: str | Manifold = "euclidean",
+    *,
+    name: str = "X",
+    min_length: int = 2,
+    min_series: int = 1,
+    atol: float = DEFAULT_ATOL,
+) -> SeriesCollection:
+    """Validate a collection of series and convert it to a :class:`SeriesCollection`.
+
+    Parameters
+    ----------
+    X : array-like or list of array-like
+        ``(n, T)``, ``(n, T, *point_shape)`` or a list of ``(T_i, *point_shape)`` series.
+    manifold : str or Manifold, default="euclidean"
+        Name (dimension inferred from the data) or manifold object.
+    name : str, default="X"
+        Name used in error messages.
+    min_length : int, default=2
+        Shortest series accepted.
+    min_series : int, default=1
+        Smallest number of series accepted.
+    atol : float, default=1e-6
+        Tolerance for the manifold constraint.
+
+    Raises
+    ------
+    ValueError
+        For empty input, wrong number of axes, NaN or infinite values, series shorter than
+        ``min_length`` and points off the manifold (naming series and time index).
+    TypeError
+        For non-numeric input.
+    """
+    if isinstance(X, (list, tuple)) and not _is_rectangular(X):
+        if len(X) == 0:
+            raise ValueError(f"{name} is empty: at least {min_series} series are needed")
+        series = [_to_float_array(s, f"{name}[{i}]") for i, s in enumerate(X)]
+        ndims = {s.ndim for s in series}
+        if 0 in ndims:
+            raise ValueError(f"each series of {name} must be an array, got a scalar")
+        ref = max(series, key=lambda s: s.ndim)
+        manifold_obj = _resolve(manifold, ref, n_lead=1, name=f"{name}[i]")
+        for i, s in enumerate(series):
+            if s.ndim == 1 and manifold_obj.point_shape == (1,):
+                series[i] = s[:, None]
+            elif s.shape[1:] != manifold_obj.point_shape:
+                raise ValueError(
+                    f"{name}[{i}] has shape {s.shape}; with {manifold_obj!r} every series must be "
+                    f"{_expected_layout(1, manifold_obj.point_shape)}."
+                )
+    else:
+        arr = _to_float_array(X, name)
+        if arr.size == 0 or arr.ndim == 0 or arr.shape[0] == 0:
+            raise ValueError(f"{name} is empty: at least {min_series} series are needed")
+        if arr.ndim < 2:
+            raise ValueError(
+                f"{name} has shape {arr.shape}; a collection of series needs at least 2 axes "
+                "(n_series, n_timepoints)"
+            )
+        manifold_obj = _resolve(manifold, arr, n_lead=2, name=name)
+        if arr.ndim == 2 and manifold_obj.point_shape == (1,):
+            arr = arr[:, :, None]
+        series = list(arr)
+    if len(series) < min_series:
+        raise ValueError(f"{name} holds {len(series)} series; at least {min_series} are needed")
+    _check_content(series, manifold_obj, name, min_length, atol)
+    lengths = np.array([len(s) for s in series], dtype=np.int64)
+    t_max = int(lengths.max())
+    data = np.empty((len(series), t_max, *manifold_obj.point_shape), dtype=np.float64)
+    for i, s in enumerate(series):
+        data[i, : len(s)] = s
+        data[i, len(s) :] = s[-1]
+    return SeriesCollection(data=data, lengths=lengths, manifold=manifold_obj)
+
+
+def _is_rectangular(X: Sequence) -> bool:
+    try:
+        arr = np.asarray(X)
+    except ValueError:
+        return False
+    return arr.dtype != object
+
+
+def _resolve(manifold: str | Manifold, arr: np.ndarray, n_lead: int, name: str) -> Manifold:
+    """Resolve the manifold against the trailing (point) axes of ``arr``."""
+    if isinstance(manifold, Manifold):
+        ps = manifold.point_shape
+        if arr.shape[n_lead:] == ps or (ps == (1,) and arr.ndim == n_lead):
+            return manifold
+        raise ValueError(
+            f"{name} has shape {arr.shape}; with {manifold!r} expected "
+            f"{_expected_layout(n_lead, ps)}."
+        )
+    if not isinstance(manifold, str):
+        raise TypeError(
+            f"manifold must be a name or a Manifold object, got {type(manifold).__name__}"
+        )
+    if arr.ndim < n_lead:
+        raise ValueError(f"{name} has shape {arr.shape}: too few axes")
+    point_shape = tuple(arr.shape[n_lead:])
+    if manifold.lower() == "euclidean" and len(point_shape) > 1:
+        layout = (
+            "(n_series, n_timepoints) or (n_series, n_timepoints, n_features)"
+            if n_lead == 2
+            else "(n_timepoints,) or (n_timepoints, n_features)"
+        )
+        raise ValueError(
+            f"{name} has {arr.ndim} axes, shape {arr.shape}; Euclidean data must be {layout}"
+        )
+    return get_manifold(manifold, point_shape=point_shape)
+
+
+def _check_content(
+    series: list[np.ndarray],
+    manifold: Manifold,
+    name: str,
+    min_length: int,
+    atol: float,
+    single: bool = False,
+) -> None:
+    for i, s in enumerate(series):
+        label = name if single else f"{name}[{i}]"
+        if len(s) < min_length:
+            raise ValueError(f"{label} has {len(s)} time points; at least {min_length} are needed")
+        finite = np.isfinite(s.reshape(len(s), -1)).all(axis=1)
+        if not finite.all():
+            t = int(np.argmin(finite))
+            where = f"{name}[{t}]" if single else f"{name}[{i}] at time index {t}"
+            raise ValueError(
+                f"{where} contains NaN or infinite values; missing values are not supported "
+                "(impute or drop them first)"
+            )
+    stacked_label = name if single else f"{name}[series, time]"
+    if single:
+        manifold.validate(series[0], atol=atol, name=stacked_label)
+        return
+    lengths = {len(s) for s in series}
+    if len(lengths) == 1:
+        manifold.validate(np.stack(series), atol=atol, name=name)
+    else:
+        for i, s in enumerate(series):
+            try:
+                manifold.validate(s, atol=atol, name=f"{name}[{i}]")
+            except ValueError as exc:
+                raise ValueError(str(exc).replace(f"{name}[{i}][", f"{name}[{i}, ")) from None

@@ -1,0 +1,192 @@
+"""Manifold DTW against aeon (Euclidean) and against a plain-Python reference."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from aeon.distances import dtw_alignment_path as aeon_dtw_path
+from aeon.distances import dtw_distance as aeon_dtw_distance
+from aeon.distances import dtw_pairwise_distance as aeon_dtw_pairwise_distance
+
+from sk_rtw.dtw import dtw_cost_matrix, dtw_distance, dtw_pairwise_distance, dtw_path
+from sk_rtw.manifolds import SPD, Product, Quaternion, Sphere, get_manifold
+
+
+def reference_dtw(x, y, manifold, squared=False, band=None):
+    """Textbook DTW with Python loops; ``band`` is a boolean mask of allowed cells."""
+    nx, ny = len(x), len(y)
+    D = np.full((nx + 1, ny + 1), np.inf)
+    D[0, 0] = 0.0
+    for i in range(nx):
+        for j in range(ny):
+            if band is not None and not band[i, j]:
+                continue
+            c = float(manifold.dist(x[i], y[j]))
+            c = c * c if squared else c
+            D[i + 1, j + 1] = c + min(D[i, j], D[i, j + 1], D[i + 1, j])
+    return D[nx, ny]
+
+
+def random_walk(manifold, length, seed, step=0.2):
+    rng = np.random.default_rng(seed)
+    p = manifold.random_point((), rng.integers(1 << 30))
+    points = [p]
+    for _ in range(length - 1):
+        v = manifold.random_tangent(points[-1], step, rng.integers(1 << 30))
+        points.append(manifold.exp(points[-1], v))
+    return np.stack(points)
+
+
+@pytest.mark.parametrize("window", [None, 0.0, 0.1, 0.3, 1.0])
+@pytest.mark.parametrize(("nx", "ny", "d"), [(30, 30, 1), (25, 40, 1), (40, 17, 3)])
+def test_matches_aeon_on_euclidean_data(nx, ny, d, window, rng):
+    x, y = rng.standard_normal((nx, d)), rng.standard_normal((ny, d))
+    expected = aeon_dtw_distance(x.T, y.T, window=window)
+    assert dtw_distance(x, y, squared=True, window=window) == pytest.approx(expected, rel=1e-12)
+    if d == 1:
+        assert dtw_distance(x[:, 0], y[:, 0], squared=True, window=window) == pytest.approx(
+            expected, rel=1e-12
+        )
+
+
+def test_path_matches_aeon(rng):
+    x, y = rng.standard_normal(30), rng.standard_normal(22)
+    path, dist = dtw_path(x, y, squared=True)
+    aeon_path, aeon_dist = aeon_dtw_path(x, y)
+    assert dist == pytest.approx(aeon_dist)
+    assert path == [tuple(map(int, p)) for p in aeon_path]
+
+
+@pytest.mark.parametrize("window", [None, 0.2])
+def test_pairwise_matches_aeon(window, rng):
+    X, Y = rng.standard_normal((6, 40)), rng.standard_normal((4, 40))
+    np.testing.assert_allclose(
+        dtw_pairwise_distance(X, Y, squared=True, window=window, n_jobs=2),
+        aeon_dtw_pairwise_distance(X, Y, window=window),
+        rtol=1e-12,
+    )
+    np.testing.assert_allclose(
+        dtw_pairwise_distance(X, squared=True, window=window),
+        aeon_dtw_pairwise_distance(X, window=window),
+        rtol=1e-12,
+    )
+
+
+def test_unequal_length_pairwise_matches_aeon(rng):
+    X = [rng.standard_normal(n) for n in (20, 31, 26)]
+    Y = [rng.standard_normal(n) for n in (18, 40)]
+    expected = np.array([[aeon_dtw_distance(x, y) for y in Y] for x in X])
+    np.testing.assert_allclose(dtw_pairwise_distance(X, Y, squared=True), expected, rtol=1e-12)
+
+
+def aeon_band(nx, ny, window):
+    from aeon.distances.elastic._bounding_matrix import create_bounding_matrix
+
+    return create_bounding_matrix(nx, ny, window=window)
+
+
+@pytest.mark.parametrize(
+    "manifold", [Sphere(1), Sphere(2), Quaternion(), SPD(2), get_manifold("pose")], ids=repr
+)
+@pytest.mark.parametrize("squared", [False, True])
+def test_matches_python_reference_on_manifolds(manifold, squared):
+    x, y = random_walk(manifold, 14, 1), random_walk(manifold, 11, 2)
+    expected = reference_dtw(x, y, manifold, squared)
+    assert dtw_distance(x, y, manifold, squared=squared) == pytest.approx(expected, rel=1e-10)
+    band = aeon_band(14, 11, 0.3)
+    expected = reference_dtw(x, y, manifold, squared, band)
+    assert dtw_distance(x, y, manifold, window=0.3, squared=squared) == pytest.approx(
+        expected, rel=1e-10
+    )
+
+
+@pytest.mark.parametrize(
+    "manifold", [Sphere(2), Quaternion(), SPD(2), get_manifold("pose")], ids=repr
+)
+def test_pairwise_matches_single_distances_on_manifolds(manifold):
+    X = [random_walk(manifold, n, 10 + n) for n in (9, 12, 7)]
+    Y = [random_walk(manifold, n, 20 + n) for n in (10, 8)]
+    expected = np.array([[dtw_distance(x, y, manifold) for y in Y] for x in X])
+    np.testing.assert_allclose(dtw_pairwise_distance(X, Y, manifold), expected, rtol=1e-10)
+    expected_xx = np.array([[dtw_distance(a, b, manifold) for b in X] for a in X])
+    np.testing.assert_allclose(
+        dtw_pairwise_distance(X, manifold=manifold), expected_xx, rtol=1e-10, atol=1e-12
+    )
+    normalised = dtw_pairwise_distance(X, Y, manifold, normalize="path")
+    expected_norm = np.array(
+        [[dtw_distance(x, y, manifold, normalize="path") for y in Y] for x in X]
+    )
+    np.testing.assert_allclose(normalised, expected_norm, rtol=1e-10)
+
+
+def test_sign_flips_do_not_change_quaternion_dtw():
+    Q = Quaternion()
+    x, y = random_walk(Q, 20, 3), random_walk(Q, 15, 4)
+    flipped = x * np.where(np.arange(20) % 3 == 0, -1.0, 1.0)[:, None]
+    assert dtw_distance(flipped, y, Q) == pytest.approx(dtw_distance(x, y, Q), rel=1e-12)
+
+
+def test_path_is_a_valid_warping_path_whose_costs_sum_to_the_distance(rng):
+    S = Sphere(2)
+    x, y = random_walk(S, 25, 5), random_walk(S, 18, 6)
+    path, dist = dtw_path(x, y, S)
+    assert path[0] == (0, 0) and path[-1] == (24, 17)
+    steps = np.diff(np.array(path), axis=0)
+    assert np.all((steps >= 0) & (steps <= 1)) and np.all(steps.sum(1) >= 1)
+    assert sum(float(S.dist(x[i], y[j])) for i, j in path) == pytest.approx(dist, rel=1e-10)
+    assert dtw_distance(x, y, S, normalize="path") == pytest.approx(dist / len(path))
+    D = dtw_cost_matrix(x, y, S)
+    assert D.shape == (25, 18) and D[-1, -1] == pytest.approx(dist)
+
+
+def test_band_cells_outside_are_infinite(rng):
+    D = dtw_cost_matrix(rng.standard_normal(20), rng.standard_normal(20), window=0.1)
+    assert np.isinf(D[0, 10]) and np.isfinite(D[10, 10])
+    np.testing.assert_array_equal(np.isfinite(D), aeon_band(20, 20, 0.1))
+
+
+def test_identical_and_time_stretched_series_have_zero_distance():
+    S = Sphere(1)
+    angles = np.linspace(0, 3, 30)
+    x = np.stack([np.cos(angles), np.sin(angles)], -1)
+    assert dtw_distance(x, x, S) == pytest.approx(0.0, abs=1e-12)
+    assert dtw_distance(x, np.repeat(x, 3, axis=0), S) == pytest.approx(0.0, abs=1e-12)
+    assert dtw_distance(x, x[::-1], S) > 1.0
+
+
+def test_distance_is_the_geodesic_cost_not_the_chordal_one():
+    S = Sphere(1)
+    x = np.array([[1.0, 0.0], [1.0, 0.0]])
+    y = np.array([[-1.0, 0.0], [-1.0, 0.0]])
+    assert dtw_distance(x, y, S) == pytest.approx(2 * math.pi)
+
+
+@pytest.mark.parametrize("window", [-0.1, 1.5])
+def test_invalid_window(window):
+    with pytest.raises(ValueError, match="window"):
+        dtw_distance(np.zeros(5), np.zeros(5), window=window)
+
+
+def test_invalid_normalize_and_bad_series():
+    with pytest.raises(ValueError, match="normalize"):
+        dtw_distance(np.zeros(5), np.zeros(5), normalize="length")
+    with pytest.raises(ValueError, match="NaN"):
+        dtw_distance(np.array([0.0, np.nan]), np.zeros(5))
+    with pytest.raises(ValueError, match="not a point"):
+        dtw_distance(np.ones((4, 3)), np.ones((4, 3)), "sphere")
+    with pytest.raises(ValueError, match="expected"):
+        dtw_distance(np.ones((4, 3)), np.ones((4, 3)), SPD(2))
+
+
+def test_product_without_numba_segments_uses_general_path():
+    M = Product((Sphere(2), SPD(2)))
+    assert M.numba_segments is None
+    rng = np.random.default_rng(0)
+    X = np.concatenate(
+        [Sphere(2).random_point((3, 6), rng), SPD(2).random_point((3, 6), rng).reshape(3, 6, 4)],
+        axis=-1,
+    )
+    D = dtw_pairwise_distance(X, manifold=M)
+    assert D[0, 1] == pytest.approx(dtw_distance(X[0], X[1], M), rel=1e-10)
