@@ -3,6 +3,8 @@
 Align, average and classify time series whose samples live on Riemannian manifolds.
 """
 
+from . import datasets, metrics
+from .align import Alignment, align
 from .dtw import dtw_cost_matrix, dtw_distance, dtw_pairwise_distance, dtw_path
 from .manifolds import (
     SPD,
@@ -19,16 +21,20 @@ __version__ = "0.1.0.dev0"
 
 __all__ = [
     "SPD",
+    "Alignment",
     "Euclidean",
     "Manifold",
     "Product",
     "Quaternion",
     "Sphere",
     "__version__",
+    "align",
     "available_manifolds",
+    "datasets",
     "dtw_cost_matrix",
     "dtw_distance",
     "dtw_pairwise_distance",
     "dtw_path",
     "get_manifold",
+    "metrics",
 ]

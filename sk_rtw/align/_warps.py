@@ -1,0 +1,130 @@
+"""Parameterised warping functions ``w_n : {1..Z} -> [0, 1]`` (boundary constraint exact).
+
+* :class:`NeuralWarps` (RTW, NTW, paper eq. 6):
+  ``w_n(z) = zhat sqrt(N) e_1[n] + zhat (1 - zhat) sum_k phi_theta(zhat)_k e_{k+1}[n]`` with
+  ``zhat = (z - 1) / (Z - 1)`` and an orthonormal basis ``e_1 = 1 / sqrt(N), e_2..e_N`` of
+  R^N. The basis is the ``Q`` of the QR decomposition of the all-ones column, held as one
+  Householder reflector, so applying it costs O(N) rather than O(N^2) per time index.
+  Because ``e_2..e_N`` are orthogonal to ``1``, the mean warp is the identity.
+  ``phi_theta`` is the network 1-512-512-(1025)-(N-1): two hidden ReLU layers of 512 and a
+  linear output layer that reads the skip-concatenation ``[h2, h1, zhat]`` (1025 values),
+  i.e. ``263680 + 1025 (N - 1) + (N - 1)`` parameters as in the paper. RTW initialises
+  the weights with Xavier (symmetry breaking), NTW with zeros.
+* :class:`SineWarps` (TTW, paper eq. 21): ``w_n = zhat + sum_k a_{n,k} sin(pi k zhat)``
+  with the coefficients centred across signals; monotonicity is restored as in the TTW
+  reference: values clamped to [0, 1], then every decrease replaced by the previous value
+  (a running maximum).
+
+The returned warps are clamped to [0, 1]; ``raw`` warps (before clamping) feed the
+monotonicity penalty.
+"""
+
+from __future__ import annotations
+
+import math
+
+import torch
+from torch import nn
+
+
+def unit_time(n_points: int, dtype=torch.float64, device=None) -> torch.Tensor:
+    """``zhat`` = ``(z - 1) / (Z - 1)`` for ``z = 1..Z``, shape (Z,)."""
+    return torch.linspace(0.0, 1.0, n_points, dtype=dtype, device=device)
+
+
+class HouseholderBasis(nn.Module):
+    """Orthonormal basis of R^N whose first vector is ``1 / sqrt(N)``, applied in O(N).
+
+    ``H = I - 2 u u^T / (u^T u)`` with ``u = e_1 - 1 / sqrt(N)`` maps ``e_1`` to the
+    normalised all-ones vector; its columns are the basis ``e_1, ..., e_N``.
+    """
+
+    def __init__(self, n_signals: int, dtype=torch.float64):
+        super().__init__()
+        u = torch.full((n_signals,), -1.0 / math.sqrt(n_signals), dtype=dtype)
+        u[0] += 1.0
+        norm_sq = float(u @ u)
+        self.register_buffer("u", u)
+        self.scale = 2.0 / norm_sq if norm_sq > 0 else 0.0
+
+    def combine(self, coefficients: torch.Tensor) -> torch.Tensor:
+        """``sum_k c_k e_{k+1}`` for ``coefficients`` (..., N-1); returns (..., N)."""
+        padded = torch.nn.functional.pad(coefficients, (1, 0))
+        return padded - self.scale * (padded @ self.u).unsqueeze(-1) * self.u
+
+    def matrix(self) -> torch.Tensor:
+        """The basis as the columns of an N x N matrix (for inspection and tests)."""
+        eye = torch.eye(self.u.numel(), dtype=self.u.dtype, device=self.u.device)
+        return eye - self.scale * torch.outer(self.u, self.u)
+
+
+class SkipMLP(nn.Module):
+    """``phi_theta``: 1 -> 512 -> 512 -> linear readout of ``[h2, h1, zhat]`` (1025)."""
+
+    def __init__(
+        self, n_outputs: int, hidden: int = 512, init: str = "xavier", dtype=torch.float64
+    ):
+        super().__init__()
+        self.hidden1 = nn.Linear(1, hidden, dtype=dtype)
+        self.hidden2 = nn.Linear(hidden, hidden, dtype=dtype)
+        self.readout = nn.Linear(2 * hidden + 1, n_outputs, dtype=dtype)
+        for layer in (self.hidden1, self.hidden2, self.readout):
+            if init == "xavier":
+                nn.init.xavier_uniform_(layer.weight)
+            elif init == "zeros":
+                nn.init.zeros_(layer.weight)
+            else:
+                raise ValueError(f"init must be 'xavier' or 'zeros', got {init!r}")
+            nn.init.zeros_(layer.bias)
+
+    def forward(self, zhat: torch.Tensor) -> torch.Tensor:
+        x = zhat.unsqueeze(-1)
+        h1 = torch.relu(self.hidden1(x))
+        h2 = torch.relu(self.hidden2(h1))
+        return self.readout(torch.cat([h2, h1, x], dim=-1))
+
+
+class NeuralWarps(nn.Module):
+    """RTW/NTW warps: identity plus ``zhat (1 - zhat)`` times a network on the basis."""
+
+    def __init__(
+        self, n_signals: int, hidden: int = 512, init: str = "xavier", dtype=torch.float64
+    ):
+        super().__init__()
+        self.n_signals = n_signals
+        self.basis = HouseholderBasis(n_signals, dtype=dtype)
+        self.phi = SkipMLP(n_signals - 1, hidden, init, dtype) if n_signals > 1 else None
+
+    def forward(self, zhat: torch.Tensor) -> torch.Tensor:
+        """Raw warps, shape (N, Z)."""
+        identity = zhat.expand(self.n_signals, -1)
+        if self.phi is None:
+            return identity
+        offsets = self.basis.combine(self.phi(zhat))  # (Z, N)
+        return identity + (zhat * (1.0 - zhat)).unsqueeze(0) * offsets.T
+
+    @staticmethod
+    def finalise(raw: torch.Tensor) -> torch.Tensor:
+        return raw.clamp(0.0, 1.0)
+
+
+class SineWarps(nn.Module):
+    """TTW warps from ``n_components`` discrete-sine-transform coefficients per signal."""
+
+    def __init__(self, n_signals: int, n_components: int = 8, dtype=torch.float64):
+        super().__init__()
+        if n_components < 1:
+            raise ValueError(f"n_components must be >= 1, got {n_components}")
+        self.coefficients = nn.Parameter(torch.zeros(n_signals, n_components, dtype=dtype))
+
+    def forward(self, zhat: torch.Tensor) -> torch.Tensor:
+        k = torch.arange(1, self.coefficients.shape[1] + 1, dtype=zhat.dtype, device=zhat.device)
+        basis = torch.sin(math.pi * k.unsqueeze(-1) * zhat)  # (K, Z)
+        # sin(pi k) is ~1e-16 in floating point: make the end points exact
+        basis = basis * ((zhat > 0) & (zhat < 1)).to(basis.dtype)
+        centred = self.coefficients - self.coefficients.mean(0, keepdim=True)
+        return zhat + centred @ basis
+
+    @staticmethod
+    def finalise(raw: torch.Tensor) -> torch.Tensor:
+        return torch.cummax(raw.clamp(0.0, 1.0), dim=-1).values
