@@ -6,6 +6,14 @@ Align, average and classify time series whose samples live on Riemannian manifol
 from . import datasets, metrics
 from .align import Alignment, align
 from .dtw import dtw_cost_matrix, dtw_distance, dtw_pairwise_distance, dtw_path
+from .estimators import (
+    NTWAverager,
+    NTWNearestCentroid,
+    RTWAverager,
+    RTWNearestCentroid,
+    TTWAverager,
+    TTWNearestCentroid,
+)
 from .manifolds import (
     SPD,
     Euclidean,
@@ -24,9 +32,15 @@ __all__ = [
     "Alignment",
     "Euclidean",
     "Manifold",
+    "NTWAverager",
+    "NTWNearestCentroid",
     "Product",
     "Quaternion",
+    "RTWAverager",
+    "RTWNearestCentroid",
     "Sphere",
+    "TTWAverager",
+    "TTWNearestCentroid",
     "__version__",
     "align",
     "available_manifolds",

@@ -89,19 +89,33 @@ def test_manifold_path_equals_euclidean_special_case(rng):
     np.testing.assert_allclose(general, flat, atol=1e-12)
 
 
-@pytest.mark.parametrize("manifold", [Sphere(1), Sphere(2), SPD(2)], ids=repr)
-def test_interpolation_gradient_matches_finite_differences(manifold):
-    x = torch.as_tensor(make_warped_signals(manifold, 1, 25, 1).original)[None]
+# The tangent-point refinement runs without gradient tracking (it is a choice of chart),
+# so the autograd derivative is exact for flat spaces and S^1 and within a fraction of a
+# percent elsewhere (the refinement contracts by ~100x per step).
+@pytest.mark.parametrize(
+    ("manifold", "rtol"),
+    [(Euclidean(2), 1e-7), (Sphere(1), 1e-7), (Sphere(2), 1e-2), (SPD(2), 1e-2)],
+    ids=repr,
+)
+def test_interpolation_gradient_matches_finite_differences(manifold, rtol):
+    x = torch.as_tensor(make_warped_signals(manifold, 1, 25, 1, amplitude=2.0).original)[None]
     # non-integer positions: at integer ones the windowed kernel has a kink (a tap enters
     # the window with zero weight but non-zero slope), so one-sided derivatives differ
-    warps = torch.tensor(
-        [[0.01, 0.13, 0.371, 0.52, 0.8666, 0.995]], dtype=torch.float64, requires_grad=True
-    )
+    warps = torch.tensor([[0.01, 0.13, 0.371, 0.52, 0.8666, 0.995]], dtype=torch.float64)
 
     def f(w):
         return tangent_sinc_interpolate(manifold, x, torch.tensor([25]), w, 10, 2)
 
-    assert torch.autograd.gradcheck(f, (warps,), atol=1e-6)
+    jacobian = torch.autograd.functional.jacobian(f, warps)
+    finite = torch.zeros_like(jacobian)
+    eps = 1e-6
+    for z in range(warps.shape[1]):
+        step = torch.zeros_like(warps)
+        step[0, z] = eps
+        finite[..., 0, z] = (f(warps + step) - f(warps - step)) / (2 * eps)
+    error = (jacobian - finite).abs().max() / finite.abs().max()
+    assert error < rtol, float(error)
+    assert finite.abs().max() > 0.1  # the test looks at a real slope
 
 
 @pytest.mark.parametrize("manifold", [Sphere(2), SPD(2)], ids=repr)

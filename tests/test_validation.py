@@ -39,15 +39,16 @@ def test_unequal_lengths_are_padded_with_the_last_sample(rng):
 @pytest.mark.parametrize(
     ("X", "manifold", "error", "match"),
     [
-        (np.zeros((0, 5)), "euclidean", ValueError, "empty"),
+        (np.zeros((0, 5)), "euclidean", ValueError, "0 sample"),
         ([], "euclidean", ValueError, "empty"),
-        (np.zeros(5), "euclidean", ValueError, "at least 2 axes"),
+        (np.zeros(5), "euclidean", ValueError, "Reshape your data"),
         (np.zeros((2, 3, 4, 5)), "euclidean", ValueError, "Euclidean data must be"),
-        (np.zeros((2, 1)), "euclidean", ValueError, "at least 2"),
+        (np.zeros((2, 1)), "euclidean", ValueError, "1 feature"),
+        ([np.zeros(1), np.zeros(3)], "euclidean", ValueError, "at least 2 are needed"),
         (np.array([[0.0, np.inf, 1.0]]), "euclidean", ValueError, "time index 1"),
         (np.ones((2, 4, 3)), "sphere", ValueError, r"X\[0, 0\].*norm"),
         (np.ones((2, 4, 3)), Quaternion(), ValueError, "expected"),
-        (np.array([["a", "b"]]), "euclidean", TypeError, "numeric"),
+        (np.array([["a", "b"]]), "euclidean", ValueError, "numeric"),
         ([np.zeros((3, 2)), np.zeros((4, 3))], "euclidean", ValueError, r"X\[1\]"),
     ],
 )
@@ -65,7 +66,7 @@ def test_off_manifold_point_in_unequal_length_list_is_located():
 
 
 def test_min_series():
-    with pytest.raises(ValueError, match="at least 2"):
+    with pytest.raises(ValueError, match="minimum of 2"):
         check_series_collection(np.zeros((1, 5)), min_series=2)
 
 

@@ -86,8 +86,13 @@ def tangent_sinc_interpolate(
     centre = torch.minimum(base.clamp_min(0), (lengths - 1).view(-1, 1))
     tangent_point = data[rows[..., 0], centre]  # (N, Z, *ps)
     weights = weights.reshape(*weights.shape, *([1] * point_ndim))
-    steps = 1 if manifold.is_flat else refinements + 1
-    for _ in range(steps):
-        vectors = manifold._log(tangent_point.unsqueeze(2), window_points)
-        tangent_point = manifold._exp(tangent_point, (weights * vectors).sum(2))
-    return tangent_point
+    if not manifold.is_flat and refinements > 0:
+        # The tangent point is a choice of chart: refine it without recording gradients
+        # (at the fixed point the result depends on it only to second order).
+        with torch.no_grad():
+            fixed_weights = weights.detach()
+            for _ in range(refinements):
+                vectors = manifold._log(tangent_point.unsqueeze(2), window_points)
+                tangent_point = manifold._exp(tangent_point, (fixed_weights * vectors).sum(2))
+    vectors = manifold._log(tangent_point.unsqueeze(2), window_points)
+    return manifold._exp(tangent_point, (weights * vectors).sum(2))

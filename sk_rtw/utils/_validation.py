@@ -19,6 +19,8 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from scipy.sparse import issparse
+from sklearn.utils import check_array
 
 from ..manifolds import Manifold, get_manifold
 
@@ -63,8 +65,12 @@ def _expected_layout(n_lead: int, point_shape: tuple[int, ...]) -> str:
     return text
 
 
+def _is_tensor(x: Any) -> bool:
+    return hasattr(x, "detach") and hasattr(x, "cpu")
+
+
 def _to_float_array(x: Any, name: str) -> np.ndarray:
-    if hasattr(x, "detach") and hasattr(x, "cpu"):
+    if _is_tensor(x):
         x = x.detach().cpu().numpy()
     try:
         arr = np.asarray(x)
@@ -139,7 +145,7 @@ def check_series_collection(
     TypeError
         For non-numeric input.
     """
-    if isinstance(X, (list, tuple)) and not _is_rectangular(X):
+    if isinstance(X, (list, tuple)) and (len(X) == 0 or not _is_rectangular(X)):
         if len(X) == 0:
             raise ValueError(f"{name} is empty: at least {min_series} series are needed")
         series = [_to_float_array(s, f"{name}[{i}]") for i, s in enumerate(X)]
@@ -157,14 +163,20 @@ def check_series_collection(
                     f"{_expected_layout(1, manifold_obj.point_shape)}."
                 )
     else:
-        arr = _to_float_array(X, name)
-        if arr.size == 0 or arr.ndim == 0 or arr.shape[0] == 0:
-            raise ValueError(f"{name} is empty: at least {min_series} series are needed")
-        if arr.ndim < 2:
-            raise ValueError(
-                f"{name} has shape {arr.shape}; a collection of series needs at least 2 axes "
-                "(n_series, n_timepoints)"
-            )
+        if _is_tensor(X):
+            X = _to_float_array(X, name)
+        # scikit-learn's checks and messages for sparse, complex, object, empty and 1-D input
+        ndim = 2 if issparse(X) else np.asarray(X).ndim
+        arr = check_array(
+            X,
+            accept_sparse=False,
+            dtype="numeric",
+            ensure_all_finite=False,
+            allow_nd=True,
+            ensure_min_samples=max(1, min_series),
+            ensure_min_features=max(1, min_length) if ndim == 2 else 1,
+            input_name=name,
+        ).astype(np.float64, copy=False)
         manifold_obj = _resolve(manifold, arr, n_lead=2, name=name)
         if arr.ndim == 2 and manifold_obj.point_shape == (1,):
             arr = arr[:, :, None]

@@ -1,0 +1,285 @@
+"""Class-mean estimators: one Riemannian time-warping mean per class."""
+
+from __future__ import annotations
+
+import sys
+import time
+from typing import Any
+
+import numpy as np
+from joblib import Parallel, delayed
+from sklearn.base import BaseEstimator, TransformerMixin
+from sklearn.utils import check_random_state, column_or_1d
+from sklearn.utils.multiclass import check_classification_targets
+from sklearn.utils.validation import check_is_fitted
+
+from ..align import Alignment, align, default_output_length
+from ..dtw import dtw_pairwise_distance
+from ..manifolds import Manifold
+from ..utils import SeriesCollection, check_series_collection
+
+
+class RTWAverager(TransformerMixin, BaseEstimator):
+    """Learn one Riemannian Time Warping mean per class; transform to DTW distances.
+
+    ``fit`` aligns the series of each class separately with :func:`sk_rtw.align` and keeps
+    the class means; ``transform`` returns the manifold-DTW distance of each series to
+    each mean (like ``KMeans.transform``).
+
+    Parameters
+    ----------
+    manifold : str or Manifold, default="euclidean"
+        Space of the samples; a name takes its dimension from the data.
+    output_length : int, optional
+        Length ``Z`` of the means. Default: ``min(N_max, 4) * T_max`` with ``N_max`` the
+        largest class (see :func:`sk_rtw.align.default_output_length`).
+    n_epochs : int, default=256
+        Adam epochs per class.
+    learning_rate : float, default=0.01
+    sinc_window, loss_window, loss_step, penalty : optional
+        Engine settings; None takes the method's default (see :func:`sk_rtw.align`).
+    n_components : int, default=8
+        Sine terms of the TTW warps (TTW only).
+    hidden_size : int, default=512
+        Hidden width of the RTW/NTW warp network.
+    tangent_refinements : int, default=2
+        Gauss–Newton refinements of the interpolation tangent point.
+    mean_iterations : int, default=5
+        Gauss–Newton iterations of the mean per epoch.
+    dtw_window : float in [0, 1], optional
+        Sakoe–Chiba band of the DTW used by ``transform``.
+    n_jobs : int, optional
+        Classes fitted in parallel (joblib) and threads of the DTW computations.
+    random_state : int, RandomState or None
+        Seeds the warp initialisation of every class.
+    device : str, default="cpu"
+        Torch device of the optimisation (e.g. ``"cuda"``); fitted attributes are numpy.
+    verbose : int, default=0
+        1: one line per class; 2: also the loss during training.
+
+    Attributes
+    ----------
+    classes_ : ndarray of shape (n_classes,)
+        Class labels (``[0]`` when fitted without ``y``).
+    means_ : ndarray of shape (n_classes, Z, *point_shape)
+        One mean per class, on the manifold.
+    alignments_ : list of Alignment
+        Per class: aligned series, warps, loss history, configuration.
+    manifold_ : Manifold
+        The manifold resolved against the training data.
+    n_features_in_ : int
+        Length of the training series when they all have the same length (a
+        scikit-learn convention; series of any length are accepted by ``transform``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sk_rtw import RTWAverager
+    >>> t = np.linspace(0, 1, 40)
+    >>> X = np.stack([np.sin(2 * np.pi * t ** p) for p in (0.8, 1.0, 1.2, 0.9)])
+    >>> averager = RTWAverager(n_epochs=10, random_state=0).fit(X, [0, 0, 1, 1])
+    >>> averager.means_.shape, averager.transform(X).shape
+    ((2, 80, 1), (4, 2))
+    """
+
+    _method = "rtw"
+
+    def __init__(
+        self,
+        manifold: str | Manifold = "euclidean",
+        output_length: int | None = None,
+        n_epochs: int = 256,
+        learning_rate: float = 0.01,
+        sinc_window: int | str | None = None,
+        loss_window: int | None = None,
+        loss_step: int | None = None,
+        penalty: float | None = None,
+        n_components: int = 8,
+        hidden_size: int = 512,
+        tangent_refinements: int = 2,
+        mean_iterations: int = 5,
+        dtw_window: float | None = None,
+        n_jobs: int | None = None,
+        random_state: Any = None,
+        device: str = "cpu",
+        verbose: int = 0,
+    ):
+        self.manifold = manifold
+        self.output_length = output_length
+        self.n_epochs = n_epochs
+        self.learning_rate = learning_rate
+        self.sinc_window = sinc_window
+        self.loss_window = loss_window
+        self.loss_step = loss_step
+        self.penalty = penalty
+        self.n_components = n_components
+        self.hidden_size = hidden_size
+        self.tangent_refinements = tangent_refinements
+        self.mean_iterations = mean_iterations
+        self.dtw_window = dtw_window
+        self.n_jobs = n_jobs
+        self.random_state = random_state
+        self.device = device
+        self.verbose = verbose
+
+    # ------------------------------------------------------------------ fit
+    def fit(self, X: Any, y: Any = None):
+        """Align the series of each class and store the class means.
+
+        Parameters
+        ----------
+        X : array-like of shape (n_series, n_timepoints[, *point_shape]) or list
+            Training series (see the input-shapes table in the user guide).
+        y : array-like of shape (n_series,), optional
+            Class labels; without ``y`` all series form one class.
+
+        Returns
+        -------
+        self
+        """
+        self._fit_means(X, y, require_two_classes=False)
+        return self
+
+    def _fit_means(self, X, y, require_two_classes):
+        collection = check_series_collection(X, self.manifold)
+        if y is None:
+            labels = np.zeros(collection.n_series, dtype=int)
+        else:
+            labels = _check_labels(y, collection.n_series, require_two_classes)
+        classes, codes = _encode(labels)
+        if require_two_classes and len(classes) < 2:
+            raise ValueError(
+                f"{type(self).__name__} needs at least 2 classes in y; got {len(classes)} "
+                f"class ({classes.tolist()})"
+            )
+        sizes = np.bincount(codes)
+        output_length = self.output_length
+        if output_length is None:
+            output_length = default_output_length(int(sizes.max()), collection.max_length)
+        seeds = check_random_state(self.random_state).randint(2**31 - 1, size=len(classes))
+        members = [np.flatnonzero(codes == k) for k in range(len(classes))]
+        jobs = (
+            delayed(self._fit_class)(_subset(collection, idx), output_length, int(seed), label)
+            for idx, seed, label in zip(members, seeds, classes, strict=True)
+        )
+        if self.n_jobs in (None, 1) or len(classes) == 1:
+            alignments = [fn(*args, **kwargs) for fn, args, kwargs in jobs]
+        else:
+            alignments = Parallel(n_jobs=self.n_jobs)(jobs)
+        self.classes_ = classes
+        self.manifold_ = collection.manifold
+        self.alignments_ = alignments
+        self.means_ = np.stack([a.mean for a in alignments])
+        if collection.equal_length and collection.manifold.point_shape == (1,):
+            self.n_features_in_ = collection.max_length
+        return self
+
+    def _fit_class(
+        self, collection: SeriesCollection, output_length: int, seed: int, label
+    ) -> Alignment:
+        start = time.perf_counter()
+        result = align(
+            collection,
+            method=self._method,
+            output_length=output_length,
+            n_epochs=self.n_epochs,
+            learning_rate=self.learning_rate,
+            sinc_window=self.sinc_window,
+            loss_window=self.loss_window,
+            loss_step=self.loss_step,
+            penalty=self.penalty,
+            random_state=seed,
+            device=self.device,
+            verbose=self.verbose >= 2,
+            n_components=self.n_components,
+            hidden_size=self.hidden_size,
+            tangent_refinements=self.tangent_refinements,
+            mean_iterations=self.mean_iterations,
+        )
+        if self.verbose:
+            name = label.item() if isinstance(label, np.generic) else label
+            print(
+                f"[{type(self).__name__}] class {name!r}: {collection.n_series} series, "
+                f"{time.perf_counter() - start:.1f} s, best epoch {result.best_epoch + 1}",
+                file=sys.stderr,
+                flush=True,
+            )
+        return result
+
+    # ------------------------------------------------------------ transform
+    def transform(self, X: Any) -> np.ndarray:
+        """Manifold-DTW distance of every series to every class mean.
+
+        Parameters
+        ----------
+        X : array-like or list of series
+            Series of any length on the training manifold.
+
+        Returns
+        -------
+        distances : ndarray of shape (n_series, n_classes)
+        """
+        check_is_fitted(self, "means_")
+        collection = check_series_collection(X, self.manifold_)
+        means = check_series_collection(self.means_, self.manifold_, name="means_")
+        return dtw_pairwise_distance(collection, means, window=self.dtw_window, n_jobs=self.n_jobs)
+
+    def __sklearn_tags__(self):
+        tags = super().__sklearn_tags__()
+        tags.input_tags.allow_nan = False
+        tags.non_deterministic = False
+        return tags
+
+
+class TTWAverager(RTWAverager):
+    """Class means by Riemannian Trainable Time Warping (sine-series warps).
+
+    Same parameters and attributes as :class:`RTWAverager`; engine defaults of ``"ttw"``.
+    """
+
+    _method = "ttw"
+
+
+class NTWAverager(RTWAverager):
+    """Class means by Riemannian Neural Time Warping (zero-initialised network, full sinc).
+
+    Same parameters and attributes as :class:`RTWAverager`; engine defaults of ``"ntw"``.
+    """
+
+    _method = "ntw"
+
+
+def _check_labels(y: Any, n_series: int, classification: bool) -> np.ndarray:
+    if isinstance(y, (list, tuple)) and len({isinstance(v, str) for v in y}) > 1:
+        y = np.array(y, dtype=object)  # keep mixed str/number labels as they are
+    labels = column_or_1d(y, warn=True)
+    if len(labels) != n_series:
+        raise ValueError(f"X has {n_series} series but y has {len(labels)} labels")
+    mixed = labels.dtype == object and len({type(v) for v in labels.tolist()}) > 1
+    if classification and not mixed:  # scikit-learn cannot sort mixed str/int labels
+        check_classification_targets(labels)
+    elif labels.dtype.kind == "f" and np.isnan(labels).any():
+        raise ValueError("y contains NaN labels")
+    return labels
+
+
+def _encode(labels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Sorted classes and integer codes; mixed label types are sorted by type, then value."""
+    try:
+        classes, codes = np.unique(labels, return_inverse=True)
+        return classes, codes.ravel()
+    except TypeError:
+        ordered = sorted(set(labels.tolist()), key=lambda v: (type(v).__name__, v))
+        classes = np.empty(len(ordered), dtype=object)
+        classes[:] = ordered
+        lookup = {v: i for i, v in enumerate(ordered)}
+        return classes, np.array([lookup[v] for v in labels.tolist()])
+
+
+def _subset(collection: SeriesCollection, index: np.ndarray) -> SeriesCollection:
+    lengths = collection.lengths[index]
+    return SeriesCollection(
+        data=collection.data[index, : int(lengths.max())],
+        lengths=lengths,
+        manifold=collection.manifold,
+    )

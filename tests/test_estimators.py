@@ -1,0 +1,231 @@
+"""scikit-learn conformance and behaviour of the estimators."""
+
+from __future__ import annotations
+
+import pickle
+
+import numpy as np
+import pytest
+from sklearn.base import clone
+from sklearn.exceptions import NotFittedError
+from sklearn.model_selection import GridSearchCV, cross_val_score
+from sklearn.pipeline import Pipeline
+from sklearn.preprocessing import FunctionTransformer
+from sklearn.utils.estimator_checks import parametrize_with_checks
+
+from sk_rtw import (
+    NTWAverager,
+    NTWNearestCentroid,
+    RTWAverager,
+    RTWNearestCentroid,
+    TTWAverager,
+    TTWNearestCentroid,
+)
+from sk_rtw.datasets import make_warped_signals
+from sk_rtw.manifolds import SPD, Euclidean, Quaternion
+
+FAST = {"n_epochs": 2, "hidden_size": 8, "random_state": 0}
+ESTIMATORS = [
+    cls(**FAST)
+    for cls in (
+        RTWAverager,
+        TTWAverager,
+        NTWAverager,
+        RTWNearestCentroid,
+        TTWNearestCentroid,
+        NTWNearestCentroid,
+    )
+]
+
+# Each expected failure of scikit-learn's generic checks, with the reason.
+_ANY_LENGTH = (
+    "series of any length are accepted at predict/transform time (DTW compares series of "
+    "different lengths; unequal-length test data is a requirement), so a different number "
+    "of columns than in fit is not an error. The other assertions of this check are "
+    "covered by test_outputs_and_probabilities and test_fit_transform_equals_fit_then_transform"
+)
+EXPECTED_FAILURES = {
+    "check_n_features_in_after_fitting": _ANY_LENGTH,
+    "check_transformer_general": _ANY_LENGTH,
+    "check_transformer_general(readonly_memmap=True)": _ANY_LENGTH,
+    "check_transformer_general(readonly_memmap=True,X_dtype=float32)": _ANY_LENGTH,
+    "check_classifiers_train": _ANY_LENGTH,
+    "check_classifiers_train(readonly_memmap=True)": _ANY_LENGTH,
+    "check_classifiers_train(readonly_memmap=True,X_dtype=float32)": _ANY_LENGTH,
+}
+
+
+def _expected_failures(estimator):
+    return EXPECTED_FAILURES
+
+
+@parametrize_with_checks(ESTIMATORS, expected_failed_checks=_expected_failures)
+def test_sklearn_compatible(estimator, check):
+    check(estimator)
+
+
+# ----------------------------------------------------------------- helpers
+def two_shape_classes(n_per_class=6, length=40, seed=0):
+    """Univariate two-class data: warped sines and warped square-ish waves."""
+    rng = np.random.default_rng(seed)
+    t = np.linspace(0, 1, length)
+    X, y = [], []
+    for label, shape in (
+        ("sine", lambda u: np.sin(2 * np.pi * u)),
+        ("bump", lambda u: np.exp(-((u - 0.5) ** 2) / 0.01)),
+    ):
+        for _ in range(n_per_class):
+            power = np.exp(rng.normal(0, 0.25))
+            X.append(shape(t**power) + 0.05 * rng.standard_normal(length))
+            y.append(label)
+    return np.array(X), np.array(y)
+
+
+def znorm(X):
+    X = np.asarray(X, dtype=float)
+    return (X - X.mean(1, keepdims=True)) / X.std(1, keepdims=True)
+
+
+# ------------------------------------------------------------------- usage
+def test_pipeline_gridsearch_clone_pickle_and_cross_validation():
+    X, y = two_shape_classes()
+    pipe = Pipeline(
+        [
+            ("scale", FunctionTransformer(znorm)),
+            ("clf", RTWNearestCentroid(n_epochs=20, hidden_size=32, random_state=0)),
+        ]
+    )
+    assert pipe.fit(X, y).score(X, y) == 1.0
+    grid = GridSearchCV(
+        RTWNearestCentroid(n_epochs=10, hidden_size=16, random_state=0),
+        {"loss_window": [0, 5], "manifold": ["euclidean", Euclidean(1)]},
+        cv=2,
+    )
+    grid.fit(X, y)
+    assert set(grid.best_params_) == {"loss_window", "manifold"}
+    assert grid.score(X, y) >= 0.9
+    scores = cross_val_score(
+        RTWNearestCentroid(n_epochs=10, hidden_size=16, random_state=0), X, y, cv=3
+    )
+    assert scores.mean() >= 0.9
+    fitted = pipe.named_steps["clf"]
+    restored = pickle.loads(pickle.dumps(pipe))
+    np.testing.assert_array_equal(restored.predict(X), pipe.predict(X))
+    cloned = clone(fitted)
+    assert cloned.get_params() == fitted.get_params() and not hasattr(cloned, "means_")
+
+
+def test_outputs_and_probabilities():
+    X, y = two_shape_classes()
+    clf = RTWNearestCentroid(n_epochs=15, hidden_size=16, random_state=0).fit(X, y)
+    distances = clf.transform(X)
+    assert distances.shape == (12, 2) and np.all(distances >= 0)
+    proba = clf.predict_proba(X)
+    np.testing.assert_allclose(proba.sum(1), 1.0)
+    np.testing.assert_array_equal(clf.classes_[proba.argmax(1)], clf.predict(X))
+    decision = clf.decision_function(X)
+    assert decision.shape == (12,)
+    np.testing.assert_array_equal(clf.classes_[(decision > 0).astype(int)], clf.predict(X))
+    assert clf.means_.shape[0] == 2 and len(clf.alignments_) == 2
+
+
+def test_averager_without_labels_and_with_a_single_series_class():
+    X, _ = two_shape_classes(3)
+    averager = RTWAverager(n_epochs=5, hidden_size=8, random_state=0).fit(X)
+    assert averager.means_.shape[0] == 1 and averager.transform(X).shape == (6, 1)
+    # Z - 1 = 3 (T - 1): every third output index is a sample of the input
+    averager = RTWAverager(
+        n_epochs=5, hidden_size=8, output_length=3 * 39 + 1, random_state=0
+    ).fit(X, [0] * 5 + [1])
+    single = averager.alignments_[1]
+    np.testing.assert_allclose(single.warps[0], np.linspace(0, 1, 118))
+    np.testing.assert_allclose(single.mean[::3, 0], X[5], atol=1e-10)
+
+
+def test_fit_transform_equals_fit_then_transform():
+    X, y = two_shape_classes(3)
+    est = RTWAverager(n_epochs=3, hidden_size=8, random_state=0)
+    np.testing.assert_allclose(est.fit_transform(X, y), clone(est).fit(X, y).transform(X))
+
+
+@pytest.mark.parametrize("labels", [["a", "b"], [3, 7], ["a", 7]])
+def test_string_integer_and_mixed_labels(labels):
+    X, y = two_shape_classes(4)
+    y = [labels[0] if v == "sine" else labels[1] for v in y]
+    clf = RTWNearestCentroid(n_epochs=10, hidden_size=16, random_state=0).fit(X, y)
+    assert set(clf.classes_.tolist()) == set(labels)
+    assert np.mean(clf.predict(X) == np.array(y, dtype=object)) >= 0.9
+
+
+def test_unequal_lengths_and_other_test_lengths():
+    X, y = two_shape_classes(4, length=50)
+    ragged = [x[: 50 - 3 * (i % 4)] for i, x in enumerate(X)]
+    clf = RTWNearestCentroid(n_epochs=10, hidden_size=16, random_state=0).fit(ragged, y)
+    X_test, y_test = two_shape_classes(3, length=35, seed=1)
+    assert np.mean(clf.predict(X_test) == y_test) >= 0.8
+
+
+@pytest.mark.parametrize(("name", "manifold"), [("quaternion", Quaternion()), ("spd", SPD(2))])
+def test_separates_two_manifold_shapes(name, manifold):
+    X, y = [], []
+    for label, seed in (("first", 10), ("second", 20)):
+        data = make_warped_signals(manifold, 5, 30, seed)
+        X.extend(data.signals)
+        y.extend([label] * 5)
+    X = np.stack(X)
+    clf = RTWNearestCentroid(manifold=name, n_epochs=20, hidden_size=16, random_state=0)
+    clf.fit(X[::2], np.array(y)[::2])
+    assert np.mean(clf.predict(X[1::2]) == np.array(y)[1::2]) == 1.0
+    manifold.validate(clf.means_, atol=1e-8)
+
+
+def test_same_random_state_same_means():
+    X, y = two_shape_classes(3)
+    a = RTWAverager(n_epochs=5, hidden_size=8, random_state=3).fit(X, y)
+    b = RTWAverager(n_epochs=5, hidden_size=8, random_state=3).fit(X, y)
+    np.testing.assert_array_equal(a.means_, b.means_)
+
+
+def test_parallel_classes_equal_sequential():
+    X, y = two_shape_classes(3)
+    a = RTWAverager(n_epochs=5, hidden_size=8, random_state=3).fit(X, y)
+    b = RTWAverager(n_epochs=5, hidden_size=8, random_state=3, n_jobs=2).fit(X, y)
+    np.testing.assert_allclose(a.means_, b.means_, atol=1e-10)
+
+
+def test_named_estimators_use_their_engine():
+    X, y = two_shape_classes(3)
+    for cls, method in ((TTWAverager, "ttw"), (NTWNearestCentroid, "ntw")):
+        est = cls(n_epochs=2, hidden_size=8, random_state=0).fit(X, y)
+        assert {a.config.method for a in est.alignments_} == {method}
+
+
+def test_verbose_reports_classes(capsys):
+    X, y = two_shape_classes(2)
+    RTWAverager(n_epochs=2, hidden_size=8, verbose=1).fit(X, y)
+    assert "class 'bump'" in capsys.readouterr().err
+
+
+# --------------------------------------------------------------- bad input
+@pytest.mark.parametrize(
+    ("X", "y", "match"),
+    [
+        (np.zeros((4, 10)), [0, 0, 0, 0], "at least 2 classes"),
+        (np.zeros((4, 10)), [0, 1, 0], "4 series but y has 3"),
+        (np.array([[0.0, np.nan, 1.0], [0.0, 1.0, 2.0]]), [0, 1], "NaN"),
+        (np.ones((2, 5, 3)), [0, 1], "not a point"),
+        (np.zeros((0, 10)), [], "0 sample"),
+        (np.zeros((2, 5, 3, 3)), [0, 1], "Euclidean data must be"),
+    ],
+)
+def test_bad_input(X, y, match):
+    manifold = "sphere" if np.asarray(X).ndim == 3 else "euclidean"
+    with pytest.raises(ValueError, match=match):
+        RTWNearestCentroid(manifold=manifold, **FAST).fit(X, y)
+
+
+def test_predict_before_fit():
+    with pytest.raises(NotFittedError):
+        RTWNearestCentroid().predict(np.zeros((2, 10)))
+    with pytest.raises(NotFittedError):
+        RTWAverager().transform(np.zeros((2, 10)))
