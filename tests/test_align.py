@@ -383,3 +383,14 @@ def test_bad_data():
 def test_verbose_reports_progress(capsys):
     align(np.random.default_rng(0).standard_normal((2, 10)), n_epochs=4, verbose=True)
     assert "epoch" in capsys.readouterr().err
+
+
+def test_top_level_align_is_the_function_even_after_submodule_imports():
+    import importlib
+
+    import sk_rtw
+
+    importlib.import_module("sk_rtw.align._loss")
+    from sk_rtw import align as top_level
+
+    assert callable(top_level) and top_level is sk_rtw.align

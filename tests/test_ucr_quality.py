@@ -25,7 +25,8 @@ def load(name: str, split: str):
 GUNPOINT_LIMIT = (
     "nearest centroid by unconstrained DTW cannot reach the Euclidean nearest centroid on "
     "GunPoint (0.753): the classes differ in timing, which DTW warps away. Measured: RTW "
-    "means 0.533, arithmetic means 0.547 (aeon's DTW too), DBA means 0.700")
+    "means 0.533, arithmetic means 0.547 (aeon's DTW too), DBA means 0.700"
+)
 
 
 # Measured with the paper defaults (256 epochs, Z = 4 T): CBF 0.768 (Euclidean nearest
@@ -33,8 +34,8 @@ GUNPOINT_LIMIT = (
 @pytest.mark.slow
 @pytest.mark.parametrize(
     "name",
-    ["CBF", pytest.param("GunPoint", marks=pytest.mark.xfail(strict=True,
-                                                             reason=GUNPOINT_LIMIT))])
+    ["CBF", pytest.param("GunPoint", marks=pytest.mark.xfail(strict=True, reason=GUNPOINT_LIMIT))],
+)
 def test_rtw_nearest_centroid_beats_euclidean_nearest_centroid(name):
     X_train, y_train = load(name, "train")
     X_test, y_test = load(name, "test")

@@ -83,10 +83,20 @@ def tangent_sinc_interpolate(
         index = torch.minimum(index.clamp_min(0), (lengths - 1).view(-1, 1, 1))
         weights = sinc_weights(frac, offsets.to(warps.dtype))
         window_points = data[rows, index]  # (N, Z, K, *ps)
+    if manifold.is_flat:
+        # Log/Exp are subtraction/addition and the weights sum to one, so the result is
+        # the weighted sum of the samples whatever the tangent point: one contraction
+        # (a batched matrix product for the full sinc) instead of (N, Z, K) tangent vectors.
+        flat = window_points.reshape(*window_points.shape[:3], -1)
+        if window is None:
+            out = torch.einsum("nzt,ntp->nzp", weights, flat[:, 0])
+        else:
+            out = torch.einsum("nzk,nzkp->nzp", weights, flat)
+        return out.reshape(*out.shape[:2], *manifold.point_shape)
     centre = torch.minimum(base.clamp_min(0), (lengths - 1).view(-1, 1))
     tangent_point = data[rows[..., 0], centre]  # (N, Z, *ps)
     weights = weights.reshape(*weights.shape, *([1] * point_ndim))
-    if not manifold.is_flat and refinements > 0:
+    if refinements > 0:
         # The tangent point is a choice of chart: refine it without recording gradients
         # (at the fixed point the result depends on it only to second order).
         with torch.no_grad():

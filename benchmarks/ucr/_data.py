@@ -1,0 +1,108 @@
+"""Loading UCR datasets through aeon and converting them to sk_rtw's time-major layout.
+
+aeon returns channels-first data: an array ``(n_cases, n_channels, n_timepoints)`` or, for
+unequal-length datasets, a list of ``(n_channels, T_i)`` arrays. Here (and only here) it
+becomes ``(n_cases, T)`` for univariate data, ``(n_cases, T, n_channels)`` otherwise, or a
+list of ``(T_i,)`` / ``(T_i, n_channels)`` series.
+
+Missing values (NaN) are filled by linear interpolation along time, the ends by the
+nearest observed value; a series with no observed value is dropped (and reported).
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+#: Datasets that aeon ships inside its package (usable with no data directory).
+AEON_BUNDLED = ("ArrowHead", "GunPoint", "ItalyPowerDemand")
+ENV_DATA_DIR = "SK_RTW_UCR_DIR"
+
+
+@dataclass
+class Split:
+    X: np.ndarray | list[np.ndarray]
+    y: np.ndarray
+    lengths: np.ndarray
+    notes: list[str] = field(default_factory=list)
+
+
+def default_data_dir() -> str | None:
+    """``$SK_RTW_UCR_DIR`` if set, else None (aeon's own location and bundled data)."""
+    return os.environ.get(ENV_DATA_DIR) or None
+
+
+def available_datasets(data_dir: str | None) -> list[str]:
+    """Datasets in aeon's local layout ``DIR/<name>/<name>_TRAIN.ts`` plus aeon's own."""
+    names = set(AEON_BUNDLED)
+    if data_dir and Path(data_dir).is_dir():
+        names.update(
+            p.name for p in Path(data_dir).iterdir() if (p / f"{p.name}_TRAIN.ts").is_file()
+        )
+    return sorted(names)
+
+
+def _fill_missing(series: np.ndarray) -> np.ndarray | None:
+    """Interpolate NaNs along time (axis 0); None if a channel has no observed value."""
+    series = np.array(series, dtype=np.float64)
+    flat = series.reshape(len(series), -1)
+    t = np.arange(len(series))
+    for c in range(flat.shape[1]):
+        observed = np.isfinite(flat[:, c])
+        if not observed.any():
+            return None
+        if not observed.all():
+            flat[:, c] = np.interp(t, t[observed], flat[observed, c])
+    return flat.reshape(series.shape)
+
+
+def load_split(name: str, split: str, data_dir: str | None) -> Split:
+    from aeon.datasets import load_classification
+
+    path = data_dir if data_dir and (Path(data_dir) / name).is_dir() else None
+    X, y = load_classification(name, split=split, extract_path=path)
+    cases = list(X) if isinstance(X, list) else list(X)
+    series, labels, notes = [], [], []
+    n_filled = 0
+    for i, case in enumerate(cases):
+        case = np.asarray(case, dtype=np.float64)  # (channels, T)
+        s = case[0] if case.shape[0] == 1 else case.T
+        if np.isnan(s).any():
+            s = _fill_missing(s)
+            if s is None:
+                notes.append(f"{split} series {i} has no observed value and was dropped")
+                continue
+            n_filled += 1
+        series.append(s)
+        labels.append(y[i])
+    if n_filled:
+        notes.append(
+            f"{n_filled} {split} series had missing values, filled by linear "
+            "interpolation along time"
+        )
+    lengths = np.array([len(s) for s in series])
+    X_out = np.stack(series) if len(set(lengths.tolist())) == 1 else series
+    return Split(X=X_out, y=np.asarray(labels), lengths=lengths, notes=notes)
+
+
+def subsample_per_class(split: Split, max_per_class: int | None, seed: int) -> np.ndarray:
+    """Indices of at most ``max_per_class`` series per class (seeded, sorted)."""
+    index = np.arange(len(split.y))
+    if not max_per_class:
+        return index
+    rng = np.random.default_rng(seed)
+    keep = []
+    for label in np.unique(split.y):
+        members = index[split.y == label]
+        if len(members) > max_per_class:
+            members = rng.choice(members, max_per_class, replace=False)
+        keep.extend(members.tolist())
+    return np.sort(np.array(keep))
+
+
+def take(split: Split, index: np.ndarray) -> Split:
+    X = split.X[index] if isinstance(split.X, np.ndarray) else [split.X[i] for i in index]
+    return Split(X=X, y=split.y[index], lengths=split.lengths[index], notes=split.notes)

@@ -1,0 +1,271 @@
+"""The per-dataset protocol of the UCR benchmark (paper, section V-A).
+
+For one dataset and each method:
+
+1. the class means from the training series of each class (rtw/ttw/ntw: the sk_rtw
+   estimators; ``dba``: aeon's ``elastic_barycenter_average`` with DTW);
+2. averaging values, per training series: ``alignment`` = DTW of the *warped* series to
+   its class mean (the paper's averaging score; rtw/ttw/ntw only) and ``barycenter`` = DTW
+   of the unwarped series to its class mean;
+3. classification: nearest class mean by DTW for every test series (``1nn-dtw``: aeon's
+   1-nearest-neighbour DTW classifier instead), keeping predictions and distances;
+4. paired t-tests (scipy ``ttest_rel``, alpha = 0.05) between every pair of methods: on
+   the per-training-series ``alignment`` values (the same series under both methods;
+   lower is better) and on the per-test-series classification outcome (1 correct,
+   0 wrong; higher is better). A difference is significant when p < alpha; identical
+   samples count as no difference.
+
+Every DTW here is sk_rtw's, with the geodesic (absolute) point cost, no window and no
+normalisation -- the paper's accumulated ``D_dtw``.
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+import os
+import sys
+import tempfile
+import time
+import traceback
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+from scipy import stats
+
+from sk_rtw import (
+    NTWNearestCentroid,
+    RTWNearestCentroid,
+    TTWNearestCentroid,
+    dtw_pairwise_distance,
+)
+
+from ._data import load_split, subsample_per_class, take
+
+ALPHA = 0.05
+WARPING_METHODS = {"rtw": RTWNearestCentroid, "ttw": TTWNearestCentroid, "ntw": NTWNearestCentroid}
+REFERENCE_METHODS = ("dba", "1nn-dtw")
+ALL_METHODS = (*WARPING_METHODS, *REFERENCE_METHODS)
+
+
+@dataclass(frozen=True)
+class RunConfig:
+    methods: tuple[str, ...] = ("rtw", "ttw", "ntw", "dba", "1nn-dtw")
+    data_dir: str | None = None
+    epochs: int = 256
+    max_series_per_class: int | None = None
+    output_length: int | None = None
+    device: str = "cpu"
+    seed: int = 0
+    time_budget: float | None = None
+    out: str = "results/ucr"
+    verbose: int = 1
+
+
+def atomic_write_json(path: Path, payload: dict) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    with os.fdopen(fd, "w") as handle:
+        json.dump(payload, handle, indent=1, default=_jsonable)
+    os.replace(tmp, path)
+
+
+def _jsonable(value):
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    return str(value)
+
+
+def _aeon_format(X):
+    """(n, T) or (n, T, C) or list -> aeon's channels-first layout."""
+    if isinstance(X, np.ndarray):
+        return X[:, None, :] if X.ndim == 2 else np.swapaxes(X, 1, 2)
+    return [s[None, :] if s.ndim == 1 else s.T for s in X]
+
+
+def _class_members(y, classes):
+    return [np.flatnonzero(y == c) for c in classes]
+
+
+def _fit_warping(method, train, test, config):
+    estimator = WARPING_METHODS[method](
+        n_epochs=config.epochs,
+        output_length=config.output_length,
+        random_state=config.seed,
+        device=config.device,
+        verbose=config.verbose,
+    )
+    start = time.perf_counter()
+    estimator.fit(train.X, train.y)
+    fit_seconds = time.perf_counter() - start
+    alignment = np.full(len(train.y), np.nan)
+    barycenter = np.full(len(train.y), np.nan)
+    for k, members in enumerate(_class_members(train.y, estimator.classes_)):
+        mean = estimator.means_[k][None]
+        aligned = estimator.alignments_[k].aligned
+        alignment[members] = dtw_pairwise_distance(aligned, mean)[:, 0]
+        series = (
+            train.X[members] if isinstance(train.X, np.ndarray) else [train.X[i] for i in members]
+        )
+        barycenter[members] = dtw_pairwise_distance(series, mean)[:, 0]
+    start = time.perf_counter()
+    distances = estimator.transform(test.X)
+    predictions = estimator.classes_[distances.argmin(1)]
+    return {
+        "fit_seconds": fit_seconds,
+        "predict_seconds": time.perf_counter() - start,
+        "alignment": alignment,
+        "barycenter": barycenter,
+        "predictions": predictions,
+        "test_distances": distances,
+        "classes": estimator.classes_,
+        "best_epochs": [a.best_epoch for a in estimator.alignments_],
+        "output_length": int(estimator.means_.shape[1]),
+    }
+
+
+def _fit_dba(train, test, config):
+    from aeon.clustering.averaging import elastic_barycenter_average
+
+    if not isinstance(train.X, np.ndarray):
+        raise ValueError("aeon's DBA needs equal-length series")
+    classes = np.unique(train.y)
+    start = time.perf_counter()
+    means = np.stack(
+        [
+            elastic_barycenter_average(
+                _aeon_format(train.X[members]), distance="dtw", random_state=config.seed
+            )[0]
+            for members in _class_members(train.y, classes)
+        ]
+    )
+    fit_seconds = time.perf_counter() - start
+    barycenter = np.full(len(train.y), np.nan)
+    for k, members in enumerate(_class_members(train.y, classes)):
+        barycenter[members] = dtw_pairwise_distance(train.X[members], means[k][None])[:, 0]
+    start = time.perf_counter()
+    distances = dtw_pairwise_distance(test.X, means)
+    return {
+        "fit_seconds": fit_seconds,
+        "predict_seconds": time.perf_counter() - start,
+        "alignment": np.full(len(train.y), np.nan),
+        "barycenter": barycenter,
+        "predictions": classes[distances.argmin(1)],
+        "test_distances": distances,
+        "classes": classes,
+    }
+
+
+def _fit_1nn(train, test, config):
+    from aeon.classification.distance_based import KNeighborsTimeSeriesClassifier
+
+    classifier = KNeighborsTimeSeriesClassifier(distance="dtw", n_neighbors=1)
+    start = time.perf_counter()
+    classifier.fit(_aeon_format(train.X), train.y)
+    fit_seconds = time.perf_counter() - start
+    start = time.perf_counter()
+    predictions = classifier.predict(_aeon_format(test.X))
+    return {
+        "fit_seconds": fit_seconds,
+        "predict_seconds": time.perf_counter() - start,
+        "predictions": predictions,
+        "classes": classifier.classes_,
+    }
+
+
+def paired_test(a: np.ndarray, b: np.ndarray, lower_is_better: bool) -> dict:
+    """Paired t-test of per-item values of methods A and B; which one is better."""
+    mask = np.isfinite(a) & np.isfinite(b)
+    a, b = a[mask], b[mask]
+    if len(a) < 2 or np.allclose(a, b):
+        return {"n": len(a), "p": None, "better": "none"}
+    p = float(stats.ttest_rel(a, b).pvalue)
+    if not np.isfinite(p) or p >= ALPHA:
+        return {"n": len(a), "p": p if np.isfinite(p) else None, "better": "none"}
+    a_better = (a.mean() < b.mean()) if lower_is_better else (a.mean() > b.mean())
+    return {"n": len(a), "p": p, "better": "a" if a_better else "b"}
+
+
+def pairwise_tests(results: dict) -> dict:
+    tests = {}
+    done = [m for m in results if "error" not in results[m] and "skipped" not in results[m]]
+    for a, b in itertools.combinations(done, 2):
+        entry = {}
+        ra, rb = results[a], results[b]
+        if "alignment" in ra and "alignment" in rb:
+            entry["averaging"] = paired_test(
+                np.asarray(ra["alignment"], float), np.asarray(rb["alignment"], float), True
+            )
+        entry["classification"] = paired_test(
+            np.asarray(ra["correct"], float), np.asarray(rb["correct"], float), False
+        )
+        tests[f"{a}|{b}"] = entry
+    return tests
+
+
+def process_dataset(name: str, config: RunConfig, position: str = "") -> dict:
+    """Run every method on one dataset and write ``<out>/datasets/<name>.json``."""
+    start = time.perf_counter()
+    record = {"dataset": name, "config": asdict(config), "methods": {}, "error": None}
+    path = Path(config.out) / "datasets" / f"{name}.json"
+    try:
+        train = load_split(name, "train", config.data_dir)
+        test = load_split(name, "test", config.data_dir)
+        kept = subsample_per_class(train, config.max_series_per_class, config.seed)
+        record.update(
+            n_train_total=len(train.y),
+            n_train=len(kept),
+            n_test=len(test.y),
+            lengths=[int(train.lengths.min()), int(train.lengths.max())],
+            n_classes=len(np.unique(train.y)),
+            notes=train.notes + test.notes,
+            train_index=kept,
+        )
+        train = take(train, kept)
+        for method in config.methods:
+            elapsed = time.perf_counter() - start
+            if config.time_budget and elapsed > config.time_budget:
+                record["methods"][method] = {
+                    "skipped": f"time budget of {config.time_budget:.0f} s used up"
+                }
+                continue
+            _log(config, f"{position} {name}: {method} ...")
+            try:
+                if method in WARPING_METHODS:
+                    out = _fit_warping(method, train, test, config)
+                elif method == "dba":
+                    out = _fit_dba(train, test, config)
+                elif method == "1nn-dtw":
+                    out = _fit_1nn(train, test, config)
+                else:
+                    raise ValueError(f"unknown method {method!r}")
+            except Exception as exc:  # one method failing must not lose the others
+                record["methods"][method] = {"error": f"{type(exc).__name__}: {exc}"}
+                _log(config, f"{position} {name}: {method} failed: {exc}")
+                continue
+            correct = (np.asarray(out["predictions"]) == test.y).astype(int)
+            out["correct"] = correct
+            out["accuracy"] = float(correct.mean())
+            record["methods"][method] = out
+            _log(
+                config,
+                f"{position} {name}: {method} accuracy {out['accuracy']:.3f} "
+                f"({out['fit_seconds']:.1f} s)",
+            )
+        record["tests"] = pairwise_tests(record["methods"])
+        record["test_labels"] = test.y
+    except Exception as exc:
+        record["error"] = f"{type(exc).__name__}: {exc}"
+        record["traceback"] = traceback.format_exc()
+        _log(config, f"{position} {name}: failed: {record['error']}")
+    record["seconds"] = time.perf_counter() - start
+    atomic_write_json(path, record)
+    return record
+
+
+def _log(config: RunConfig, text: str) -> None:
+    if config.verbose:
+        print(text, file=sys.stderr, flush=True)

@@ -1,0 +1,174 @@
+"""Summary across datasets: Table II of the paper, mean accuracy and rank, scatter plot."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+from scipy.stats import rankdata
+
+PAIRS = (("ttw", "rtw"), ("ntw", "rtw"), ("dba", "rtw"), ("1nn-dtw", "rtw"), ("ttw", "ntw"))
+PAPER_TABLE_II = {  # averaging, classification (% of 128 datasets)
+    ("ttw", "rtw"): {"a": (7.34, 5.47), "b": (39.84, 54.69), "none": (52.82, 39.84)},
+    ("ntw", "rtw"): {"a": (7.81, 6.25), "b": (8.59, 35.16), "none": (83.60, 58.59)},
+}
+
+
+def load_records(out: Path) -> list[dict]:
+    return [json.loads(p.read_text()) for p in sorted((out / "datasets").glob("*.json"))]
+
+
+def _test(record, a, b, kind):
+    tests = record.get("tests", {})
+    if f"{a}|{b}" in tests:
+        entry = tests[f"{a}|{b}"].get(kind)
+        return entry and entry["better"]
+    if f"{b}|{a}" in tests:
+        entry = tests[f"{b}|{a}"].get(kind)
+        flip = {"a": "b", "b": "a", "none": "none"}
+        return entry and flip[entry["better"]]
+    return None
+
+
+def table_ii(records: list[dict]) -> list[dict]:
+    rows = []
+    for a, b in PAIRS:
+        row = {"pair": (a, b)}
+        for kind in ("averaging", "classification"):
+            outcomes = [o for o in (_test(r, a, b, kind) for r in records) if o]
+            n = len(outcomes)
+            row[kind] = {
+                k: (100.0 * outcomes.count(k) / n if n else float("nan"))
+                for k in ("a", "b", "none")
+            }
+            row[kind]["n"] = n
+        rows.append(row)
+    return rows
+
+
+def accuracy_matrix(records, methods):
+    names, rows = [], []
+    for r in records:
+        accs = [r["methods"].get(m, {}).get("accuracy") for m in methods]
+        if r.get("error") is None and all(a is not None for a in accs):
+            names.append(r["dataset"])
+            rows.append(accs)
+    return names, np.array(rows, dtype=float).reshape(len(rows), len(methods))
+
+
+def markdown(records: list[dict], methods: list[str], command: str, machine: str) -> str:
+    lines = [
+        "# UCR benchmark: RTW vs TTW vs NTW (and DBA, 1-NN DTW references)",
+        "",
+        f"Command: `{command}`  ",
+        f"Machine: {machine}",
+        "",
+    ]
+    failed = [r for r in records if r.get("error")]
+    lines += [f"Datasets: {len(records)} ({len(failed)} failed).", ""]
+    names, acc = accuracy_matrix(records, methods)
+    if len(names):
+        ranks = np.mean([rankdata(-row) for row in acc], axis=0)
+        lines += [
+            "## Mean accuracy and mean rank over the datasets where every method ran "
+            f"({len(names)})",
+            "",
+            "| method | mean accuracy | mean rank |",
+            "| --- | --- | --- |",
+        ]
+        lines += [
+            f"| {m} | {acc[:, i].mean():.4f} | {ranks[i]:.2f} |" for i, m in enumerate(methods)
+        ]
+        lines.append("")
+    lines += [
+        "## Paired t-tests (alpha = 0.05): share of datasets (Table II layout)",
+        "",
+        "| comparison | averaging | classification | paper averaging | paper classification |",
+        "| --- | --- | --- | --- | --- |",
+    ]
+    for row in table_ii(records):
+        a, b = row["pair"]
+        if not row["classification"]["n"]:
+            continue
+        paper = PAPER_TABLE_II.get((a, b))
+        for key, label in (
+            ("a", f"{a.upper()} significantly better than {b.upper()}"),
+            ("b", f"{b.upper()} significantly better than {a.upper()}"),
+            ("none", "no significant difference"),
+        ):
+            avg = row["averaging"]
+            avg_text = f"{avg[key]:.2f} % (n={avg['n']})" if avg["n"] else "-"
+            cls = row["classification"]
+            p_avg, p_cls = (
+                (f"{paper[key][0]:.2f} %", f"{paper[key][1]:.2f} %") if paper else ("-", "-")
+            )
+            lines.append(
+                f"| {label} | {avg_text} | {cls[key]:.2f} % (n={cls['n']}) | {p_avg} | {p_cls} |"
+            )
+    lines += [
+        "",
+        "## Per dataset accuracy",
+        "",
+        "| dataset | n_train | n_test | T | " + " | ".join(methods) + " |",
+        "| --- | --- | --- | --- | " + " | ".join("---" for _ in methods) + " |",
+    ]
+    for r in records:
+        if r.get("error"):
+            lines.append(f"| {r['dataset']} | failed: {r['error']} |")
+            continue
+        cells = []
+        for m in methods:
+            entry = r["methods"].get(m, {})
+            cells.append(
+                f"{entry['accuracy']:.3f}"
+                if "accuracy" in entry
+                else entry.get("error", entry.get("skipped", "-"))[:40]
+            )
+        lo, hi = r["lengths"]
+        length = str(lo) if lo == hi else f"{lo}-{hi}"
+        lines.append(
+            f"| {r['dataset']} | {r['n_train']} | {r['n_test']} | {length} | "
+            + " | ".join(cells)
+            + " |"
+        )
+    notes = [f"- {r['dataset']}: {n}" for r in records for n in r.get("notes", [])]
+    if notes:
+        lines += ["", "## Notes", "", *notes]
+    return "\n".join(lines) + "\n"
+
+
+def scatter_plot(records: list[dict], path: Path) -> bool:
+    """RTW accuracy (y) against TTW and NTW accuracy (x), one point per dataset."""
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        return False
+    fig, ax = plt.subplots(figsize=(5, 5))
+    for other, colour in (("ttw", "tab:red"), ("ntw", "gold")):
+        names, acc = accuracy_matrix(records, [other, "rtw"])
+        if len(names):
+            ax.scatter(
+                acc[:, 0],
+                acc[:, 1],
+                c=colour,
+                label=f"{other.upper()} (x) vs RTW (y)",
+                edgecolors="k",
+                linewidths=0.4,
+            )
+    ax.plot([0, 1], [0, 1], "k--", lw=0.8)
+    ax.set(
+        xlim=(0, 1.02),
+        ylim=(0, 1.02),
+        xlabel="TTW / NTW accuracy",
+        ylabel="RTW accuracy",
+        title="Nearest-centroid accuracy per UCR dataset",
+    )
+    ax.legend(loc="lower right")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return True

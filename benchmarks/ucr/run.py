@@ -1,0 +1,204 @@
+"""UCR benchmark: DTW averaging and nearest-centroid classification, RTW vs TTW vs NTW.
+
+The paper's section V-A as a rerunnable tool. For each dataset, each method learns one mean
+per class from the training split; the script scores the averaging (DTW of every warped
+training series to its class mean) and the classification of the test split (nearest
+class mean by DTW), runs paired t-tests between the methods, and summarises them across
+datasets in the layout of the paper's Table II, with a scatter plot like its Fig. 3.
+
+Examples::
+
+    python benchmarks/ucr/run.py                       # aeon's bundled datasets, offline
+    python benchmarks/ucr/run.py --data-dir ../shared/ucr --all --epochs 64 --resume
+    python benchmarks/ucr/run.py --datasets CBF GunPoint --methods rtw ttw
+    python benchmarks/ucr/run.py --all --jobs 8 --backend dask --scheduler tcp://host:8786
+
+Results (``--out``, default ``results/ucr``)::
+
+    datasets/<name>.json    one file per dataset, written atomically when it finishes:
+                            configuration, per-method accuracy, fit time, per-training-
+                            series averaging values, per-test-series predictions and
+                            distances, paired t-tests, errors
+    summary.md              the tables printed at the end
+    accuracy_scatter.png    RTW against TTW/NTW accuracy per dataset
+
+``--resume`` skips datasets whose file exists without an error, so an interrupted run
+loses at most the datasets in progress. A dataset (or a method) that fails is recorded
+with its error and the run goes on.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import shlex
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
+
+from benchmarks.ucr._data import (  # noqa: E402
+    AEON_BUNDLED,
+    ENV_DATA_DIR,
+    available_datasets,
+    default_data_dir,
+)
+from benchmarks.ucr._protocol import ALL_METHODS, RunConfig, process_dataset  # noqa: E402
+from benchmarks.ucr._summary import load_records, markdown, scatter_plot  # noqa: E402
+
+
+def parse_args(argv=None) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(
+        description=__doc__.splitlines()[0],
+        epilog=__doc__.split("Examples::")[1],
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument(
+        "--data-dir",
+        default=default_data_dir(),
+        help=f"archive in aeon's local layout (default: ${ENV_DATA_DIR}, else "
+        "aeon's own location with its bundled datasets)",
+    )
+    which = parser.add_mutually_exclusive_group()
+    which.add_argument("--datasets", nargs="+", metavar="NAME")
+    which.add_argument(
+        "--all", action="store_true", help="every dataset in --data-dir plus aeon's bundled ones"
+    )
+    parser.add_argument(
+        "--methods", nargs="+", default=list(ALL_METHODS), choices=list(ALL_METHODS)
+    )
+    parser.add_argument("--epochs", type=int, default=256)
+    parser.add_argument(
+        "--max-series-per-class",
+        type=int,
+        default=None,
+        help="train on a seeded random subset of at most this many series "
+        "per class (the test split is always complete)",
+    )
+    parser.add_argument(
+        "--output-length",
+        type=int,
+        default=None,
+        help="length Z of the means (default: min(N, 4) T)",
+    )
+    parser.add_argument("--device", default="cpu")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--jobs", type=int, default=1, help="datasets in parallel")
+    parser.add_argument(
+        "--backend",
+        default="loky",
+        help="joblib backend: loky, threading, multiprocessing or dask",
+    )
+    parser.add_argument(
+        "--scheduler", default=None, help="dask scheduler address (default: a local dask cluster)"
+    )
+    parser.add_argument(
+        "--time-budget",
+        type=float,
+        default=None,
+        help="seconds per dataset; methods not started by then are skipped",
+    )
+    parser.add_argument("--out", default="results/ucr")
+    parser.add_argument("--resume", action="store_true")
+    parser.add_argument("--quiet", action="store_true")
+    return parser.parse_args(argv)
+
+
+def select_datasets(args) -> list[str]:
+    if args.datasets:
+        return list(args.datasets)
+    if args.all:
+        return available_datasets(args.data_dir)
+    return list(AEON_BUNDLED)
+
+
+def finished(out: Path, name: str) -> bool:
+    import json
+
+    path = out / "datasets" / f"{name}.json"
+    if not path.is_file():
+        return False
+    try:
+        return json.loads(path.read_text()).get("error") is None
+    except ValueError:
+        return False
+
+
+def run_all(names: list[str], config: RunConfig, jobs: int, backend: str, scheduler):
+    from joblib import Parallel, delayed, parallel_config
+
+    total = len(names)
+    tasks = [
+        delayed(process_dataset)(name, config, f"[{i + 1:>3}/{total}]")
+        for i, name in enumerate(names)
+    ]
+    if backend == "dask":
+        from dask.distributed import Client, LocalCluster
+
+        os.environ["PYTHONPATH"] = os.pathsep.join(
+            [str(ROOT), *filter(None, [os.environ.get("PYTHONPATH")])]
+        )
+        client = (
+            Client(scheduler)
+            if scheduler
+            else Client(LocalCluster(n_workers=jobs, threads_per_worker=1))
+        )
+        print(f"dask: {client}", file=sys.stderr)
+        with client, parallel_config(backend="dask"):
+            return Parallel(verbose=0)(tasks)
+    if jobs == 1:
+        return [task[0](*task[1], **task[2]) for task in tasks]
+    with parallel_config(backend=backend, n_jobs=jobs):
+        return Parallel()(tasks)
+
+
+def main(argv=None) -> int:
+    args = parse_args(argv)
+    out = Path(args.out)
+    names = select_datasets(args)
+    todo = [n for n in names if not (args.resume and finished(out, n))]
+    config = RunConfig(
+        methods=tuple(args.methods),
+        data_dir=args.data_dir,
+        epochs=args.epochs,
+        max_series_per_class=args.max_series_per_class,
+        output_length=args.output_length,
+        device=args.device,
+        seed=args.seed,
+        time_budget=args.time_budget,
+        out=str(out),
+        verbose=0 if args.quiet else 1,
+    )
+    print(
+        f"{len(names)} dataset(s), {len(names) - len(todo)} already done; methods "
+        f"{', '.join(args.methods)}; {args.epochs} epochs; results in {out}",
+        file=sys.stderr,
+    )
+    start = time.perf_counter()
+    run_all(todo, config, args.jobs, args.backend, args.scheduler)
+    records = [r for r in load_records(out) if r["dataset"] in names]
+    command = "python benchmarks/ucr/run.py " + " ".join(
+        shlex.quote(a) for a in (argv if argv is not None else sys.argv[1:])
+    )
+    machine = (
+        f"{platform.machine()}, {os.cpu_count()} cores, Python "
+        f"{platform.python_version()}, device {args.device}; "
+        f"{time.perf_counter() - start:.0f} s for {len(todo)} dataset(s)"
+    )
+    text = markdown(records, list(args.methods), command.strip(), machine)
+    (out / "summary.md").write_text(text)
+    plotted = scatter_plot(records, out / "accuracy_scatter.png")
+    print(text)
+    print(
+        f"written: {out / 'summary.md'}"
+        + (f", {out / 'accuracy_scatter.png'}" if plotted else " (no matplotlib: no plot)")
+    )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

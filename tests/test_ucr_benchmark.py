@@ -1,0 +1,75 @@
+"""The UCR benchmark tool: results per dataset, resume, failures recorded, odd datasets."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from benchmarks.ucr._data import load_split
+from benchmarks.ucr._protocol import paired_test
+from benchmarks.ucr.run import main
+
+from .conftest import UCR_DIR
+
+
+def test_small_run_writes_results_resumes_and_records_failures(tmp_path, capsys):
+    out = tmp_path / "results"
+    args = [
+        "--datasets",
+        "ItalyPowerDemand",
+        "NoSuchDataset",
+        "--methods",
+        "rtw",
+        "ttw",
+        "dba",
+        "1nn-dtw",
+        "--epochs",
+        "2",
+        "--max-series-per-class",
+        "6",
+        "--out",
+        str(out),
+        "--quiet",
+    ]
+    assert main(args) == 0
+    record = json.loads((out / "datasets" / "ItalyPowerDemand.json").read_text())
+    assert record["error"] is None and record["n_train"] == 12
+    for method in ("rtw", "ttw", "dba", "1nn-dtw"):
+        entry = record["methods"][method]
+        assert 0.0 <= entry["accuracy"] <= 1.0
+        assert len(entry["predictions"]) == record["n_test"] == 1029
+    assert len(record["methods"]["rtw"]["alignment"]) == 12
+    assert set(record["tests"]) >= {"rtw|ttw", "rtw|dba"}
+    failed = json.loads((out / "datasets" / "NoSuchDataset.json").read_text())
+    assert failed["error"]
+    summary = (out / "summary.md").read_text()
+    assert "Table II" in summary and "ItalyPowerDemand" in summary
+    assert (out / "accuracy_scatter.png").stat().st_size > 0
+    mtime = (out / "datasets" / "ItalyPowerDemand.json").stat().st_mtime_ns
+    capsys.readouterr()
+    main([*args, "--resume"])
+    assert (out / "datasets" / "ItalyPowerDemand.json").stat().st_mtime_ns == mtime
+    assert "1 already done" in capsys.readouterr().err
+
+
+def test_paired_test_decisions():
+    a = np.array([1.0, 2.0, 3.0, 4.0, 5.0, 6.0])
+    assert paired_test(a, a + 1.0 + 0.01 * np.arange(6), True)["better"] == "a"
+    assert paired_test(a, a + 1.0 + 0.01 * np.arange(6), False)["better"] == "b"
+    assert paired_test(a, a, True)["better"] == "none"
+    noisy = a + np.array([0.5, -0.5, 0.4, -0.4, 0.1, -0.1])
+    assert paired_test(a, noisy, True)["better"] == "none"
+
+
+def test_unequal_lengths_are_kept_as_lists():
+    split = load_split("PickupGestureWiimoteZ", "train", None)
+    assert isinstance(split.X, list) and split.lengths.min() < split.lengths.max()
+
+
+@pytest.mark.skipif(not (UCR_DIR / "DodgerLoopGame").is_dir(), reason="no DodgerLoopGame")
+def test_missing_values_are_interpolated_and_reported():
+    split = load_split("DodgerLoopGame", "train", str(UCR_DIR))
+    assert np.isfinite(np.asarray(split.X)).all()
+    assert any("interpolation" in note for note in split.notes)
