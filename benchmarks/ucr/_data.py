@@ -64,7 +64,7 @@ def load_split(name: str, split: str, data_dir: str | None) -> Split:
 
     path = data_dir if data_dir and (Path(data_dir) / name).is_dir() else None
     X, y = load_classification(name, split=split, extract_path=path)
-    cases = list(X) if isinstance(X, list) else list(X)
+    cases = list(X)  # (channels, T) arrays, equal lengths or not
     series, labels, notes = [], [], []
     n_filled = 0
     for i, case in enumerate(cases):
