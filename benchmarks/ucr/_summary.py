@@ -8,6 +8,8 @@ from pathlib import Path
 import numpy as np
 from scipy.stats import rankdata
 
+from ._protocol import pairwise_tests
+
 PAIRS = (("ttw", "rtw"), ("ntw", "rtw"), ("dba", "rtw"), ("1nn-dtw", "rtw"), ("ttw", "ntw"))
 PAPER_TABLE_II = {  # averaging, classification (% of 128 datasets)
     ("ttw", "rtw"): {"a": (7.34, 5.47), "b": (39.84, 54.69), "none": (52.82, 39.84)},
@@ -20,7 +22,8 @@ def load_records(out: Path) -> list[dict]:
 
 
 def _test(record, a, b, kind):
-    tests = record.get("tests", {})
+    # recomputed from the stored per-series values, so every record is judged alike
+    tests = pairwise_tests(record.get("methods", {}))
     if f"{a}|{b}" in tests:
         entry = tests[f"{a}|{b}"].get(kind)
         return entry and entry["better"]
