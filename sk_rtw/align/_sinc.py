@@ -21,15 +21,29 @@ returned.
 
 from __future__ import annotations
 
+import math
+
 import torch
 
 from ..manifolds import Manifold
 
 
-def sinc_weights(frac: torch.Tensor, offsets: torch.Tensor) -> torch.Tensor:
-    """Normalised sinc weights ``sinc(k - frac)`` over the last axis."""
-    weights = torch.sinc(offsets - frac.unsqueeze(-1))
-    return weights / weights.sum(-1, keepdim=True)
+def shifted_sinc(offsets: torch.Tensor, parity: torch.Tensor, frac: torch.Tensor) -> torch.Tensor:
+    """``sinc(k - frac)`` for integer offsets ``k`` (last axis) and ``frac`` in [0, 1).
+
+    Uses ``sin(pi (k - f)) = -(-1)^k sin(pi f)``, so the sine is evaluated once per
+    position instead of once per tap, and each tap costs one division. ``parity`` is
+    ``(-1)^k``, broadcastable to ``offsets``.
+    """
+    distance = offsets - frac.unsqueeze(-1)
+    at_sample = distance == 0
+    sine = torch.sin(math.pi * frac).unsqueeze(-1)
+    safe = torch.where(at_sample, torch.ones_like(distance), distance)
+    return torch.where(at_sample, torch.ones_like(distance), -parity * sine / (math.pi * safe))
+
+
+def _parity(k: torch.Tensor) -> torch.Tensor:
+    return 1.0 - 2.0 * torch.remainder(k, 2).to(torch.float64)
 
 
 def tangent_sinc_interpolate(
@@ -70,18 +84,23 @@ def tangent_sinc_interpolate(
     base = base.long()
     rows = torch.arange(n_series, device=data.device).view(-1, 1, 1)
     if window is None:
-        offsets = torch.arange(t_max, device=data.device, dtype=warps.dtype)
-        # weights for every sample m: sinc(m - tau); samples beyond T_n get weight zero
-        weights = torch.sinc(offsets - tau.unsqueeze(-1))
-        valid = offsets.unsqueeze(0) < lengths.unsqueeze(-1).to(warps.dtype)  # (N, T)
-        weights = weights * valid.unsqueeze(1)
+        samples = torch.arange(t_max, device=data.device)
+        # weights for every sample m: sinc(m - tau) = sinc((m - floor(tau)) - frac);
+        # samples beyond T_n get weight zero
+        offsets = (samples - base.unsqueeze(-1)).to(warps.dtype)  # (N, Z, T)
+        parity = _parity(samples).to(warps.dtype) * _parity(base).to(warps.dtype).unsqueeze(-1)
+        weights = shifted_sinc(offsets, parity, frac)
+        valid = samples.unsqueeze(0) < lengths.unsqueeze(-1)  # (N, T)
+        weights = weights * valid.unsqueeze(1).to(warps.dtype)
         weights = weights / weights.sum(-1, keepdim=True)
         window_points = data.unsqueeze(1)  # (N, 1, T, *ps)
     else:
         offsets = torch.arange(-window, window + 1, device=data.device)
         index = base.unsqueeze(-1) + offsets  # (N, Z, K)
         index = torch.minimum(index.clamp_min(0), (lengths - 1).view(-1, 1, 1))
-        weights = sinc_weights(frac, offsets.to(warps.dtype))
+        k = offsets.to(warps.dtype)
+        weights = shifted_sinc(k, _parity(offsets).to(warps.dtype), frac)
+        weights = weights / weights.sum(-1, keepdim=True)
         window_points = data[rows, index]  # (N, Z, K, *ps)
     if manifold.is_flat:
         # Log/Exp are subtraction/addition and the weights sum to one, so the result is
