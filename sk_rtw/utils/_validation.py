@@ -52,9 +52,6 @@ class SeriesCollection:
         """The ``i``-th series without padding, shape ``(T_i, *point_shape)``."""
         return self.data[i, : self.lengths[i]]
 
-    def to_list(self) -> list[np.ndarray]:
-        return [self.series(i) for i in range(self.n_series)]
-
 
 def _expected_layout(n_lead: int, point_shape: tuple[int, ...]) -> str:
     lead = "(n_series, n_timepoints" if n_lead == 2 else "(n_timepoints"
