@@ -115,6 +115,8 @@ def main(argv=None) -> None:
         f"machine: {platform.machine()}, {torch.get_num_threads()} torch threads, "
         f"device {args.device}, torch {torch.__version__}"
     )
+    # warm up torch's thread pool and allocator once, so the first row is not penalised
+    epoch_seconds(make_warped_signals("sphere", 4, T, 1).signals, "rtw", 4 * T, args.device)
     print(f"\n1. S^1, T = {T}, Z = min(N, 4) T, full fit = {epochs} epochs")
     print(
         f"{'N':>4} {'method':>6} {'Z':>5} {'s/epoch':>9} {'s/fit':>9} "
