@@ -17,6 +17,8 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from ..manifolds._base import SEGMENT_EUCLIDEAN, SEGMENT_SIGN_INVARIANT_SPHERE
+
 _INF = np.inf
 
 
@@ -109,25 +111,28 @@ def final_cost(cost: np.ndarray, nx: int, ny: int, window: float) -> float:
     return prev[ny]
 
 
+@njit(cache=True, inline="always")
+def _step_back(D, i, j):
+    """One step back along the optimal path (ties: diagonal, then up, then left)."""
+    if i == 0:
+        return i, j - 1
+    if j == 0:
+        return i - 1, j
+    diag, up, left = D[i - 1, j - 1], D[i - 1, j], D[i, j - 1]
+    if diag <= up and diag <= left:
+        return i - 1, j - 1
+    if up <= left:
+        return i - 1, j
+    return i, j - 1
+
+
 @njit(cache=True)
 def path_length(D: np.ndarray) -> int:
     """Number of steps of the optimal path encoded in an accumulated cost matrix."""
     i, j = D.shape[0] - 1, D.shape[1] - 1
     steps = 1
     while i > 0 or j > 0:
-        if i == 0:
-            j -= 1
-        elif j == 0:
-            i -= 1
-        else:
-            diag, up, left = D[i - 1, j - 1], D[i - 1, j], D[i, j - 1]
-            if diag <= up and diag <= left:
-                i -= 1
-                j -= 1
-            elif up <= left:
-                i -= 1
-            else:
-                j -= 1
+        i, j = _step_back(D, i, j)
         steps += 1
     return steps
 
@@ -155,19 +160,7 @@ def backtrack(D: np.ndarray):
     i, j = D.shape[0] - 1, D.shape[1] - 1
     path = [(i, j)]
     while i > 0 or j > 0:
-        if i == 0:
-            j -= 1
-        elif j == 0:
-            i -= 1
-        else:
-            diag, up, left = D[i - 1, j - 1], D[i - 1, j], D[i, j - 1]
-            if diag <= up and diag <= left:
-                i -= 1
-                j -= 1
-            elif up <= left:
-                i -= 1
-            else:
-                j -= 1
+        i, j = _step_back(D, i, j)
         path.append((i, j))
     path.reverse()
     return path
@@ -182,12 +175,12 @@ def _cost_row(x, y, i, ny, segments, squared, row):
         row[j] = 0.0
     for s in range(n_segments):
         start, stop, code = segments[s, 0], segments[s, 1], segments[s, 2]
-        if code == 0 and stop - start == 1:
+        if code == SEGMENT_EUCLIDEAN and stop - start == 1:
             a = xi[start]
             for j in range(ny):
                 diff = a - y[j, start]
                 row[j] += diff * diff
-        elif code == 0:
+        elif code == SEGMENT_EUCLIDEAN:
             for j in range(ny):
                 sq = 0.0
                 for k in range(start, stop):
@@ -203,7 +196,9 @@ def _cost_row(x, y, i, ny, segments, squared, row):
                 for k in range(start, stop):
                     r = y[j, k] - dot * xi[k]
                     perp += r * r
-                angle = math.atan2(math.sqrt(perp), abs(dot) if code == 2 else dot)
+                angle = math.atan2(
+                    math.sqrt(perp), abs(dot) if code == SEGMENT_SIGN_INVARIANT_SPHERE else dot
+                )
                 row[j] += angle * angle
     if not squared:
         for j in range(ny):
