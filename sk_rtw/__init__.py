@@ -3,7 +3,7 @@
 Align, average and classify time series whose samples live on Riemannian manifolds.
 """
 
-from . import datasets, metrics
+from . import baselines, datasets, metrics
 from .align import Alignment, align
 from .dtw import dtw_cost_matrix, dtw_distance, dtw_pairwise_distance, dtw_path
 from .estimators import (
@@ -44,6 +44,7 @@ __all__ = [
     "__version__",
     "align",
     "available_manifolds",
+    "baselines",
     "datasets",
     "dtw_cost_matrix",
     "dtw_distance",

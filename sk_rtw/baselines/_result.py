@@ -1,0 +1,89 @@
+"""The result type shared by the DTW-family baselines and their path helpers."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..dtw import _kernels
+from ..dtw._dtw import point_cost_matrix
+from ..manifolds import Manifold
+
+
+@dataclass(frozen=True, eq=False)
+class MultipleAlignment:
+    """Joint alignment of N series by a DTW-family method.
+
+    Attributes
+    ----------
+    mean : ndarray of shape (L, *point_shape)
+        Average series on the manifold.
+    aligned : ndarray of shape (N, L, *point_shape)
+        Every input series resampled on the common time axis: ``aligned[n, l]`` is
+        ``X[n][indices[n, l]]``.
+    indices : ndarray of shape (N, L), int
+        Sample of series ``n`` matched with step ``l`` of the common axis (non-decreasing).
+    warps : ndarray of shape (N, L)
+        ``indices`` as relative positions in [0, 1] (0 = first, 1 = last sample), the
+        counterpart of :attr:`sk_rtw.Alignment.warps`.
+    cost : float
+        The objective the method minimised (its definition is given by each method).
+    manifold : Manifold
+    """
+
+    mean: np.ndarray
+    aligned: np.ndarray
+    indices: np.ndarray
+    warps: np.ndarray
+    cost: float
+    manifold: Manifold
+
+
+def make_result(
+    series: list[np.ndarray], indices: np.ndarray, mean: np.ndarray, cost: float, manifold
+) -> MultipleAlignment:
+    """Assemble a :class:`MultipleAlignment` from per-series index arrays ``(N, L)``."""
+    indices = np.asarray(indices, dtype=np.int64)
+    aligned = np.stack([s[i] for s, i in zip(series, indices, strict=True)])
+    scale = np.array([max(len(s) - 1, 1) for s in series], dtype=float)[:, None]
+    return MultipleAlignment(
+        mean=mean,
+        aligned=aligned,
+        indices=indices,
+        warps=indices / scale,
+        cost=float(cost),
+        manifold=manifold,
+    )
+
+
+def dtw_path_array(
+    x: np.ndarray, y: np.ndarray, manifold: Manifold, window: float, squared: bool
+) -> tuple[np.ndarray, float]:
+    """Optimal DTW path ``(L, 2)`` between two validated series, and its cost."""
+    D = _kernels.accumulated_cost(point_cost_matrix(x, y, manifold, squared), window)
+    if not np.isfinite(D[-1, -1]):
+        raise ValueError("the Sakoe–Chiba window is too narrow to connect the series ends")
+    return np.asarray(_kernels.backtrack(D), dtype=np.int64).reshape(-1, 2), float(D[-1, -1])
+
+
+def grouped_mean(
+    manifold: Manifold, groups: np.ndarray, points: np.ndarray, n_groups: int
+) -> np.ndarray:
+    """Fréchet mean of ``points`` per group label in ``range(n_groups)``, all at once.
+
+    Groups of different sizes are padded to the largest one with zero-weight copies of
+    their first point, so one batched Gauss–Newton run averages every group.
+    """
+    order = np.argsort(groups, kind="stable")
+    groups, points = groups[order], points[order]
+    counts = np.bincount(groups, minlength=n_groups)
+    if np.any(counts == 0):
+        raise ValueError("every group needs at least one point")
+    starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    slots = np.arange(len(groups)) - starts[groups]
+    padded = np.repeat(points[starts][:, None], counts.max(), axis=1)
+    padded[groups, slots] = points
+    weights = np.zeros((n_groups, counts.max()))
+    weights[groups, slots] = 1.0
+    return manifold.mean(padded, weights.T, axis=1)
