@@ -17,6 +17,8 @@ from .dtw import dtw_pairwise_distance
 from .manifolds import Manifold
 from .utils import check_series_collection
 
+__all__ = ["alignment_quality", "barycenter_loss", "restoration_accuracy"]
+
 
 def _sum_dtw_to(series: Any, reference: Any, manifold, normalize, window, n_jobs) -> float:
     collection = check_series_collection(series, manifold, name="series", min_length=1)

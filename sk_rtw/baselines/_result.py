@@ -68,12 +68,18 @@ def dtw_path_array(
 
 
 def grouped_mean(
-    manifold: Manifold, groups: np.ndarray, points: np.ndarray, n_groups: int
+    manifold: Manifold,
+    groups: np.ndarray,
+    points: np.ndarray,
+    n_groups: int,
+    start: np.ndarray | None = None,
+    max_iter: int = 64,
 ) -> np.ndarray:
     """Fréchet mean of ``points`` per group label in ``range(n_groups)``, all at once.
 
     Groups of different sizes are padded to the largest one with zero-weight copies of
-    their first point, so one batched Gauss–Newton run averages every group.
+    their first point, so one batched Gauss–Newton run averages every group. ``start``
+    ``(n_groups, *point_shape)`` puts a starting estimate first in every group (weight 0).
     """
     order = np.argsort(groups, kind="stable")
     groups, points = groups[order], points[order]
@@ -82,8 +88,11 @@ def grouped_mean(
         raise ValueError("every group needs at least one point")
     starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
     slots = np.arange(len(groups)) - starts[groups]
-    padded = np.repeat(points[starts][:, None], counts.max(), axis=1)
-    padded[groups, slots] = points
-    weights = np.zeros((n_groups, counts.max()))
-    weights[groups, slots] = 1.0
-    return manifold.mean(padded, weights.T, axis=1)
+    offset = 0 if start is None else 1
+    padded = np.repeat(points[starts][:, None], counts.max() + offset, axis=1)
+    if start is not None:
+        padded[:, 0] = start
+    padded[groups, slots + offset] = points
+    weights = np.zeros((n_groups, counts.max() + offset))
+    weights[groups, slots + offset] = 1.0
+    return manifold.mean(padded, weights.T, axis=1, max_iter=max_iter)

@@ -13,7 +13,7 @@ from ._base import Manifold
 
 @dataclass(frozen=True)
 class Product(Manifold):
-    """Product manifold ``M_1 x ... x M_m`` with the product metric.
+    """Product manifold ``M_1 x … x M_m`` with the product metric.
 
     A point is the concatenation of the flattened factor points, so a pose
     ``R^3 x S^3`` is 7 numbers ``(x, y, z, qw, qx, qy, qz)``. The distance is

@@ -1,0 +1,164 @@
+"""Shared pieces of the paper experiments: running a method, scoring, Markdown tables."""
+
+from __future__ import annotations
+
+import platform
+import shlex
+import sys
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from sk_rtw import align, metrics
+from sk_rtw.baselines import dba_average, mmddtw_align, pdtw_average, qdtw_align
+
+ENGINE_METHODS = ("rtw", "ttw", "ntw")
+LABELS = {
+    "rtw": "RTW",
+    "ttw": "TTW",
+    "ntw": "NTW",
+    "mmddtw": "MMDDTW",
+    "mmddtw_c": "MMDDTW_C",
+    "pdtw": "p-DTW",
+    "qdtw": "QDTW",
+    "dba": "DBA",
+    "unaligned": "unaligned",
+    "interpolation": "interpolation",
+}
+
+
+@dataclass
+class Outcome:
+    """What every method returns: a mean, the aligned series, warps in [0, 1], seconds."""
+
+    mean: np.ndarray
+    aligned: np.ndarray
+    warps: np.ndarray
+    seconds: float
+
+
+def run_method(
+    method: str,
+    X,
+    manifold,
+    *,
+    epochs: int = 256,
+    output_length: int | None = None,
+    seed: int = 0,
+    device: str = "cpu",
+) -> Outcome:
+    """Run one method of the paper's tables (or DBA) on the series ``X``."""
+    start = time.perf_counter()
+    if method in ENGINE_METHODS:
+        r = align(
+            X,
+            manifold=manifold,
+            method=method,
+            n_epochs=epochs,
+            output_length=output_length,
+            random_state=seed,
+            device=device,
+        )
+    elif method == "mmddtw":
+        r = mmddtw_align(X, manifold)
+    elif method == "mmddtw_c":
+        r = mmddtw_align(X, manifold, metric="cholesky")
+    elif method == "qdtw":
+        r = qdtw_align(X)
+    elif method == "pdtw":
+        r = pdtw_average(X, manifold)
+    elif method == "dba":
+        r = dba_average(X, manifold)
+    else:
+        raise ValueError(f"unknown method {method!r}")
+    return Outcome(r.mean, r.aligned, r.warps, time.perf_counter() - start)
+
+
+def unaligned(X, manifold, length: int | None = None) -> Outcome:
+    """Naive interpolation: every series resampled to one length, then averaged pointwise.
+
+    Resampling picks the nearest sample at evenly spaced relative positions; the mean is
+    the Fréchet mean across series at every step.
+    """
+    series = [np.asarray(s) for s in X]
+    length = length or max(len(s) for s in series)
+    grid = np.linspace(0.0, 1.0, length)
+    aligned = np.stack([s[np.round(grid * (len(s) - 1)).astype(int)] for s in series])
+    mean = manifold.mean(aligned)
+    return Outcome(mean, aligned, np.tile(grid, (len(series), 1)), 0.0)
+
+
+def score(outcome: Outcome, X, manifold, original=None) -> dict[str, float]:
+    """Barycenter loss, alignment quality (and restoration accuracy given ``original``)."""
+    values = {}
+    if original is not None:
+        values["RA"] = metrics.restoration_accuracy(outcome.aligned, original, manifold)
+    values["BL"] = metrics.barycenter_loss(X, outcome.mean, manifold)
+    values["AQ"] = metrics.alignment_quality(outcome.aligned, outcome.mean, manifold)
+    values["seconds"] = outcome.seconds
+    return values
+
+
+def machine() -> str:
+    return (
+        f"{platform.machine()}, {torch.get_num_threads()} torch threads, "
+        f"torch {torch.__version__}, Python {platform.python_version()}"
+    )
+
+
+def command_line() -> str:
+    return "python " + shlex.join([Path(sys.argv[0]).as_posix(), *sys.argv[1:]])
+
+
+def format_cell(values: Sequence[float], best: bool = False) -> str:
+    values = np.asarray(values, dtype=float)
+    text = f"{values.mean():.4g}"
+    if len(values) > 1:
+        text += f" ± {values.std():.2g}"
+    return f"**{text}**" if best else text
+
+
+def markdown_table(
+    results: dict[str, list[dict[str, float]]],
+    columns: Sequence[str],
+    paper: dict[str, Sequence[float]] | None = None,
+) -> str:
+    """One row per method: mean ± std over runs, best (lowest mean) in bold, paper values."""
+    means = {
+        c: {m: np.mean([r[c] for r in rows]) for m, rows in results.items() if rows}
+        for c in columns
+    }
+    best = {
+        c: min((v, m) for m, v in means[c].items() if m not in ("unaligned", "interpolation"))[1]
+        for c in columns
+        if c != "seconds" and len(means[c]) > 1
+    }
+    header = ["method", *columns] + (["paper"] if paper else [])
+    lines = ["| " + " | ".join(header) + " |", "|" + " --- |" * len(header)]
+    for method, rows in results.items():
+        if not rows:
+            continue
+        cells = [LABELS.get(method, method)]
+        cells += [format_cell([r[c] for r in rows], best.get(c) == method) for c in columns]
+        if paper:
+            cells.append(" / ".join(f"{v:g}" for v in paper.get(method, ())) or "")
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def write_markdown(path: str | None, title: str, intro: str, sections: dict[str, str]) -> None:
+    """Print the tables and, with ``path``, write them as a Markdown page."""
+    body = [f"# {title}", "", intro.strip(), "", f"Command: `{command_line()}`", ""]
+    body += [f"Machine: {machine()}.", ""]
+    for heading, text in sections.items():
+        body += [f"## {heading}", "", text.strip(), ""]
+    page = "\n".join(body)
+    print(page, flush=True)
+    if path:
+        Path(path).parent.mkdir(parents=True, exist_ok=True)
+        Path(path).write_text(page)
+        print(f"written to {path}", file=sys.stderr)

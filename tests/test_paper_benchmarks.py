@@ -1,0 +1,92 @@
+"""Helpers of the paper experiments: robot kinematics, letters on S^3, a small S^1 run."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from benchmarks.paper import inverted_s1
+from benchmarks.paper._data import (
+    letters_on_s3,
+    planar_arm_kinematics,
+    planar_arm_mass_matrix,
+    quaternion_exp,
+    quaternion_product,
+    track_with_planar_arm,
+)
+
+
+def test_planar_arm_jacobian_matches_finite_differences(rng):
+    lengths, q = rng.uniform(0.1, 0.3, 5), rng.uniform(-1, 1, 5)
+    _, J = planar_arm_kinematics(q, lengths)
+    eps = 1e-6
+    fd = np.stack(
+        [
+            (
+                planar_arm_kinematics(q + eps * e, lengths)[0]
+                - planar_arm_kinematics(q - eps * e, lengths)[0]
+            )
+            / (2 * eps)
+            for e in np.eye(5)
+        ],
+        axis=-1,
+    )
+    np.testing.assert_allclose(J, fd, atol=1e-8)
+
+
+def test_planar_arm_mass_matrix_gives_the_kinetic_energy_of_the_rods(rng):
+    n = 4
+    lengths, masses = rng.uniform(0.1, 0.3, n), rng.uniform(0.5, 2.0, n)
+    q, qdot = rng.uniform(-1, 1, n), rng.standard_normal(n)
+    s = np.linspace(0.0, 1.0, 4001)
+
+    def rod_points(angles):
+        theta, base, points = np.cumsum(angles), np.zeros(2), []
+        for k in range(n):
+            direction = np.array([np.cos(theta[k]), np.sin(theta[k])])
+            points.append(base + np.outer(s * lengths[k], direction))
+            base = base + lengths[k] * direction
+        return points
+
+    h = 1e-6
+    ahead, behind = rod_points(q + h * qdot), rod_points(q - h * qdot)
+    energy = sum(
+        0.5 * m * np.trapezoid((((a - b) / (2 * h)) ** 2).sum(1), s)
+        for m, a, b in zip(masses, ahead, behind, strict=True)
+    )
+    M = planar_arm_mass_matrix(q, lengths, masses)
+    assert 0.5 * qdot @ M @ qdot == pytest.approx(energy, rel=1e-6)
+    np.testing.assert_allclose(M, M.T)
+    assert np.linalg.eigvalsh(M).min() > 0
+
+
+def test_inverse_kinematics_follows_the_targets():
+    lengths = np.full(4, 0.25)
+    t = np.linspace(0, 1, 30)
+    targets = np.stack([0.5 + 0.1 * np.cos(2 * np.pi * t), 0.2 * np.sin(2 * np.pi * t)], -1)
+    q = track_with_planar_arm(targets[None], lengths)
+    reached, _ = planar_arm_kinematics(q, lengths)
+    np.testing.assert_allclose(reached[0], targets, atol=1e-8)
+
+
+def test_quaternion_helpers_match_scipy(rng):
+    p, q = rng.standard_normal((2, 10, 4))
+    p /= np.linalg.norm(p, axis=-1, keepdims=True)
+    q /= np.linalg.norm(q, axis=-1, keepdims=True)
+    expected = Rotation.from_quat(p, scalar_first=True) * Rotation.from_quat(q, scalar_first=True)
+    got = Rotation.from_quat(quaternion_product(p, q), scalar_first=True)
+    np.testing.assert_allclose((got.inv() * expected).magnitude(), 0.0, atol=1e-10)
+    u = rng.standard_normal((10, 3)) * 0.5
+    rotvec = Rotation.from_quat(quaternion_exp(u), scalar_first=True).as_rotvec()
+    np.testing.assert_allclose(rotvec, 2 * u, atol=1e-12)  # Exp without the factor 1/2
+    letters = rng.uniform(-10, 10, (2, 20, 2))
+    on_s3 = letters_on_s3(letters, 0.05)
+    np.testing.assert_allclose(np.linalg.norm(on_s3, axis=-1), 1.0)
+
+
+def test_inverted_s1_runs_the_dtw_baselines(capsys):
+    inverted_s1.main(["--n-signals", "3", "--trials", "1", "--methods", "mmddtw", "pdtw", "dba"])
+    out = capsys.readouterr().out
+    for label in ("MMDDTW", "p-DTW", "DBA", "unaligned", "| method | RA | BL | AQ"):
+        assert label in out
