@@ -67,7 +67,23 @@ def barycenter_loss(
 ) -> float:
     """``sum_n D_dtw(x_n, mean)``: how well the mean represents the input (eq. 20b).
 
-    Parameters as in :func:`restoration_accuracy`, with ``signals`` the input series.
+    Parameters
+    ----------
+    signals : array-like, shape (N, T, *point_shape) or list of series
+        The input series (before alignment).
+    mean : array-like, shape (Z, *point_shape)
+    manifold : str or Manifold, default="euclidean"
+    normalize : {"path", None}, default="path"
+        DTW normalisation (see the module docstring).
+    window : float in [0, 1], optional
+        Sakoe–Chiba band of the DTW (default: none, as in the paper).
+    n_jobs : int, optional
+        Threads for the DTW computations.
+
+    Returns
+    -------
+    value : float
+        Sum over the N series; lower is better.
     """
     return _sum_dtw_to(signals, mean, manifold, normalize, window, n_jobs)
 
@@ -83,6 +99,22 @@ def alignment_quality(
     """``sum_n D_dtw(aligned_n, mean)``: closeness of the aligned signals to their mean
     (eq. 20c).
 
-    Parameters as in :func:`restoration_accuracy`.
+    Parameters
+    ----------
+    aligned : array-like, shape (N, Z, *point_shape) or list of series
+        The aligned series.
+    mean : array-like, shape (Z, *point_shape)
+    manifold : str or Manifold, default="euclidean"
+    normalize : {"path", None}, default="path"
+        DTW normalisation (see the module docstring).
+    window : float in [0, 1], optional
+        Sakoe–Chiba band of the DTW (default: none, as in the paper).
+    n_jobs : int, optional
+        Threads for the DTW computations.
+
+    Returns
+    -------
+    value : float
+        Sum over the N series; lower is better.
     """
     return _sum_dtw_to(aligned, mean, manifold, normalize, window, n_jobs)

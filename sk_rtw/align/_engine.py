@@ -55,7 +55,12 @@ DEFAULT_LENGTH_FACTOR = 4
 
 @dataclass(frozen=True)
 class AlignmentConfig:
-    """The resolved configuration of one :func:`align` run."""
+    """The resolved configuration of one :func:`align` run.
+
+    Every field is the value actually used (method defaults filled in); ``output_length``
+    is ``Z``, the length of ``Alignment.mean`` (shape ``(Z, *point_shape)``) and of every
+    aligned series. See :func:`align` for the meaning of each field.
+    """
 
     method: str
     warp: str
@@ -74,6 +79,12 @@ class AlignmentConfig:
     device: str
 
     def to_dict(self) -> dict[str, Any]:
+        """The configuration as a plain dictionary (field name to value).
+
+        Returns
+        -------
+        config : dict
+        """
         return asdict(self)
 
 
@@ -133,6 +144,18 @@ def default_output_length(n_signals: int, max_length: int) -> int:
 
     The cap keeps memory and time linear in ``N`` for large classes; see the output-length
     study in the docs for the measurements behind the factor.
+
+    Parameters
+    ----------
+    n_signals : int
+        Number of series N aligned together.
+    max_length : int
+        Length of the longest series, ``T_max``.
+
+    Returns
+    -------
+    Z : int
+        Length of the mean, shape ``(Z, *point_shape)``, and of every aligned series.
     """
     return max(2, min(n_signals, DEFAULT_LENGTH_FACTOR) * max_length)
 

@@ -30,7 +30,18 @@ def available_memory() -> int:
 
 
 def grid_bytes(lengths) -> int:
-    """Bytes of the float64 accumulated-cost grid over series of these lengths."""
+    """Bytes of the float64 accumulated-cost grid of :func:`mmddtw_align`.
+
+    Parameters
+    ----------
+    lengths : sequence of int
+        Lengths ``T_n`` of the N series.
+
+    Returns
+    -------
+    n_bytes : int
+        ``8 * prod(T_n)``: the grid has shape ``(T_1, ..., T_N)``.
+    """
     return 8 * math.prod(int(t) for t in lengths)
 
 

@@ -22,6 +22,16 @@ def quaternion_cost_matrix(x: np.ndarray, y: np.ndarray, cost: str = "geodesic")
     ``"geodesic"``: ``arccos |<p, q>|``, the distance on S^3 modulo ``q ~ -q`` (half the
     rotation angle between the orientations). ``"dot"``: ``1 - |<p, q>|``, the cheaper
     inner-product form; both order pairs of orientations in the same way.
+
+    Parameters
+    ----------
+    x : ndarray of shape (T_x, 4)
+    y : ndarray of shape (T_y, 4)
+    cost : {"geodesic", "dot"}, default="geodesic"
+
+    Returns
+    -------
+    C : ndarray of shape (T_x, T_y)
     """
     if cost == "geodesic":
         return point_cost_matrix(x, y, Quaternion())

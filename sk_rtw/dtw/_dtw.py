@@ -42,7 +42,19 @@ def _check_normalize(normalize: str | None) -> None:
 def point_cost_matrix(
     x: np.ndarray, y: np.ndarray, manifold: Manifold, squared: bool = False
 ) -> np.ndarray:
-    """Cost matrix ``C[i, j] = dist(x[i], y[j])`` (or its square) of two validated series."""
+    """Cost matrix ``C[i, j] = dist(x[i], y[j])`` (or its square) of two validated series.
+
+    Parameters
+    ----------
+    x : ndarray of shape (T_x, *point_shape)
+    y : ndarray of shape (T_y, *point_shape)
+    manifold : Manifold
+    squared : bool, default=False
+
+    Returns
+    -------
+    C : ndarray of shape (T_x, T_y)
+    """
     segments = manifold.numba_segments
     if segments is not None:
         out = np.empty((len(x), len(y)))
@@ -154,6 +166,13 @@ def dtw_path(
     squared: bool = False,
 ) -> tuple[list[tuple[int, int]], float]:
     """Optimal DTW alignment path and its accumulated cost.
+
+    Parameters
+    ----------
+    x : array-like, shape (T_x,) or (T_x, *point_shape)
+    y : array-like, shape (T_y,) or (T_y, *point_shape)
+    manifold, window, squared
+        As in :func:`dtw_distance`.
 
     Returns
     -------

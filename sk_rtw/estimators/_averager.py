@@ -234,7 +234,9 @@ class RTWAverager(TransformerMixin, BaseEstimator):
 class TTWAverager(RTWAverager):
     """Class means by Riemannian Trainable Time Warping (sine-series warps).
 
-    Same parameters and attributes as :class:`RTWAverager`; engine defaults of ``"ttw"``.
+    Same parameters, attributes and input shapes (``(n_series, n_timepoints[,
+    *point_shape])`` or a list of series) as :class:`RTWAverager`; engine defaults of
+    ``"ttw"``.
     """
 
     _method = "ttw"
@@ -243,7 +245,9 @@ class TTWAverager(RTWAverager):
 class NTWAverager(RTWAverager):
     """Class means by Riemannian Neural Time Warping (zero-initialised network, full sinc).
 
-    Same parameters and attributes as :class:`RTWAverager`; engine defaults of ``"ntw"``.
+    Same parameters, attributes and input shapes (``(n_series, n_timepoints[,
+    *point_shape])`` or a list of series) as :class:`RTWAverager`; engine defaults of
+    ``"ntw"``.
     """
 
     _method = "ntw"

@@ -20,7 +20,10 @@ class RTWNearestCentroid(ClassifierMixin, RTWAverager):
 
     Parameters
     ----------
-    Same as :class:`RTWAverager`.
+    manifold, output_length, n_epochs, learning_rate, sinc_window, loss_window, \
+loss_step, penalty, n_components, hidden_size, tangent_refinements, mean_iterations, \
+dtw_window, n_jobs, random_state, device, verbose
+        As in :class:`RTWAverager`.
 
     Attributes
     ----------
@@ -46,7 +49,8 @@ class RTWNearestCentroid(ClassifierMixin, RTWAverager):
 
         Parameters
         ----------
-        X : array-like or list of series
+        X : array-like of shape (n_series, n_timepoints[, *point_shape]) or list
+            Training series (a list of ``(T_i, *point_shape)`` arrays for unequal lengths).
         y : array-like of shape (n_series,)
             Labels of at least two classes (strings, integers or a mix).
 
@@ -61,17 +65,48 @@ class RTWNearestCentroid(ClassifierMixin, RTWAverager):
         return self._fit_means(X, y, require_two_classes=True)
 
     def predict(self, X: Any) -> np.ndarray:
-        """Label of the nearest class mean, shape (n_series,)."""
+        """Label of the nearest class mean.
+
+        Parameters
+        ----------
+        X : array-like of shape (n_series, n_timepoints[, *point_shape]) or list
+            Series on the training manifold; any length (a list for unequal lengths).
+
+        Returns
+        -------
+        labels : ndarray of shape (n_series,)
+        """
         distances = self.transform(X)
         return self.classes_[np.argmin(distances, axis=1)]
 
     def predict_proba(self, X: Any) -> np.ndarray:
-        """Softmax of the negative DTW distances, shape (n_series, n_classes)."""
+        """Softmax of the negative DTW distances to the class means.
+
+        Parameters
+        ----------
+        X : array-like of shape (n_series, n_timepoints[, *point_shape]) or list
+            Series on the training manifold; any length (a list for unequal lengths).
+
+        Returns
+        -------
+        proba : ndarray of shape (n_series, n_classes)
+        """
         return softmax(-self.transform(X), axis=1)
 
     def decision_function(self, X: Any) -> np.ndarray:
-        """Negative DTW distances (n_series, n_classes); for two classes the 1-D score
-        ``d(x, mean_0) - d(x, mean_1)``, positive towards ``classes_[1]``."""
+        """Confidence scores: negative DTW distances to the class means.
+
+        Parameters
+        ----------
+        X : array-like of shape (n_series, n_timepoints[, *point_shape]) or list
+            Series on the training manifold; any length (a list for unequal lengths).
+
+        Returns
+        -------
+        scores : ndarray of shape (n_series, n_classes) or (n_series,)
+            For two classes the 1-D score ``d(x, mean_0) - d(x, mean_1)``, positive
+            towards ``classes_[1]``.
+        """
         check_is_fitted(self, "means_")
         distances = self.transform(X)
         if len(self.classes_) == 2:
@@ -80,14 +115,22 @@ class RTWNearestCentroid(ClassifierMixin, RTWAverager):
 
 
 class TTWNearestCentroid(RTWNearestCentroid):
-    """Nearest-centroid classifier on Riemannian TTW class means (see
-    :class:`RTWNearestCentroid`)."""
+    """Nearest-centroid classifier on Riemannian TTW class means.
+
+    Same parameters, attributes and input shapes (``(n_series, n_timepoints[,
+    *point_shape])`` or a list of series) as :class:`RTWNearestCentroid`; engine defaults
+    of ``"ttw"``.
+    """
 
     _method = "ttw"
 
 
 class NTWNearestCentroid(RTWNearestCentroid):
-    """Nearest-centroid classifier on Riemannian NTW class means (see
-    :class:`RTWNearestCentroid`)."""
+    """Nearest-centroid classifier on Riemannian NTW class means.
+
+    Same parameters, attributes and input shapes (``(n_series, n_timepoints[,
+    *point_shape])`` or a list of series) as :class:`RTWNearestCentroid`; engine defaults
+    of ``"ntw"``.
+    """
 
     _method = "ntw"

@@ -33,6 +33,11 @@ SEGMENT_SIGN_INVARIANT_SPHERE = 2
 class Manifold(ABC):
     """Riemannian manifold: exponential and logarithmic maps, distance, Fréchet mean.
 
+    Points are arrays of shape ``point_shape`` (e.g. ``(3,)`` on S^2, ``(2, 2)`` on
+    SPD(2)); every operation broadcasts over leading axes, so a series is
+    ``(T, *point_shape)`` and a collection ``(n, T, *point_shape)``. numpy input gives
+    numpy output; torch input gives differentiable torch output.
+
     Subclasses implement the torch methods ``_exp``, ``_log``, ``_dist``, ``_norm``,
     ``_project`` and ``_point_problems``; everything else is derived here.
     """
@@ -136,12 +141,33 @@ class Manifold(ABC):
 
     @numpy_compatible
     def squared_dist(self, p, x):
-        """Squared geodesic distance (smooth where the distance is zero)."""
+        """Squared geodesic distance (smooth where the distance is zero).
+
+        Parameters
+        ----------
+        p, x : array-like or torch.Tensor, shape (..., *point_shape)
+
+        Returns
+        -------
+        d2 : same type as the input, shape (...)
+        """
         return self._dist(p, x) ** 2
 
     @numpy_compatible
     def norm(self, p, v):
-        """Riemannian norm of the tangent vector ``v`` at ``p``; shape (...)."""
+        """Riemannian norm of the tangent vector ``v`` at ``p``.
+
+        Parameters
+        ----------
+        p : array-like or torch.Tensor, shape (..., *point_shape)
+            Base points.
+        v : array-like or torch.Tensor, shape (..., *point_shape)
+            Tangent vectors at ``p``.
+
+        Returns
+        -------
+        n : same type as the input, shape (...)
+        """
         return self._norm(p, v)
 
     @numpy_compatible
@@ -166,7 +192,17 @@ class Manifold(ABC):
 
     @numpy_compatible
     def project(self, X):
-        """Nearest point on the manifold (normalise, symmetrise, clip eigenvalues, ...)."""
+        """Nearest point on the manifold (normalise, symmetrise, clip eigenvalues, ...).
+
+        Parameters
+        ----------
+        X : array-like or torch.Tensor, shape (..., *point_shape)
+            Points near the manifold.
+
+        Returns
+        -------
+        points : same type as the input, shape (..., *point_shape)
+        """
         return self._project(X)
 
     def mean(
@@ -243,13 +279,36 @@ class Manifold(ABC):
                 )
 
     def random_point(self, n_points: int | tuple[int, ...] = (), random_state=None):
-        """Random points (numpy), shape ``(*n_points, *point_shape)``."""
+        """Random points, for tests and examples.
+
+        Parameters
+        ----------
+        n_points : int or tuple of int, default=()
+            Leading shape; ``()`` gives a single point.
+        random_state : int, Generator, RandomState or None
+
+        Returns
+        -------
+        points : ndarray of shape (*n_points, *point_shape)
+        """
         rng = check_generator(random_state)
         leading = (n_points,) if isinstance(n_points, int) else tuple(n_points)
         return self._random_point(leading, rng)
 
     def random_tangent(self, p: Any, scale: float = 1.0, random_state=None):
-        """Random tangent vectors at ``p`` (numpy), with entries of size about ``scale``."""
+        """Random tangent vectors at ``p``, with entries of size about ``scale``.
+
+        Parameters
+        ----------
+        p : array-like of shape (..., *point_shape)
+            Base points.
+        scale : float, default=1.0
+        random_state : int, Generator, RandomState or None
+
+        Returns
+        -------
+        v : ndarray of shape (..., *point_shape)
+        """
         rng = check_generator(random_state)
         p = np.asarray(p, dtype=np.float64)
         return self._random_tangent(p, scale, rng)

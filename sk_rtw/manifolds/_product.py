@@ -16,7 +16,8 @@ class Product(Manifold):
     """Product manifold ``M_1 x … x M_m`` with the product metric.
 
     A point is the concatenation of the flattened factor points, so a pose
-    ``R^3 x S^3`` is 7 numbers ``(x, y, z, qw, qx, qy, qz)``. The distance is
+    ``R^3 x S^3`` is 7 numbers ``(x, y, z, qw, qx, qy, qz)``: ``point_shape`` is
+    ``(sum_i prod(point_shape_i),)`` and a series is ``(T, point_shape[0])``. The distance is
     ``sqrt(sum_i dist_i^2)``; ``exp`` and ``log`` act factor by factor.
 
     Parameters

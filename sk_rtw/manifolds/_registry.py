@@ -85,7 +85,14 @@ _FIXED_DIMENSION = {"quaternion", "pose"}
 
 
 def available_manifolds() -> dict[str, ManifoldSpec]:
-    """The registry: manifold names mapped to their specification."""
+    """The registry: manifold names mapped to their specification.
+
+    Returns
+    -------
+    registry : dict of str to ManifoldSpec
+        For example ``"sphere"``, whose spec builds ``Sphere(d)`` from a point shape
+        ``(d + 1,)``.
+    """
     return dict(_REGISTRY)
 
 

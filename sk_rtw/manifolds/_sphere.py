@@ -115,6 +115,8 @@ class Quaternion(Sphere):
     distance is invariant to ``q -> -q`` (it is half the rotation angle). Hence ``mean``
     aligns every sample with the hemisphere of the current estimate at each Gauss–Newton
     step, and series that flip sign between samples are interpolated without jumps.
+
+    Points have shape ``(4,)``; a series is ``(T, 4)``.
     """
 
     dim: int = 3

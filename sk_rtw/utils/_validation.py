@@ -49,7 +49,16 @@ class SeriesCollection:
         return bool(np.all(self.lengths == self.max_length))
 
     def series(self, i: int) -> np.ndarray:
-        """The ``i``-th series without padding, shape ``(T_i, *point_shape)``."""
+        """The ``i``-th series without padding.
+
+        Parameters
+        ----------
+        i : int
+
+        Returns
+        -------
+        series : ndarray of shape (T_i, *point_shape)
+        """
         return self.data[i, : self.lengths[i]]
 
 
@@ -92,6 +101,18 @@ def check_series(
     atol: float = DEFAULT_ATOL,
 ) -> tuple[np.ndarray, Manifold]:
     """Validate one series ``(T,)`` or ``(T, *point_shape)``.
+
+    Parameters
+    ----------
+    x : array-like of shape (T,) or (T, *point_shape)
+    manifold : str or Manifold, default="euclidean"
+        Name (dimension inferred from the data) or manifold object.
+    name : str, default="x"
+        Name used in error messages.
+    min_length : int, default=2
+        Shortest series accepted.
+    atol : float, default=1e-6
+        Tolerance for the manifold constraint.
 
     Returns
     -------
