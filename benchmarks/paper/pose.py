@@ -79,7 +79,7 @@ def evaluate(series, methods, epochs, seed, device):
             ("orientation", Quaternion(), slice(3, 7)),
         ):
             values[f"AQ {part}"] = metrics.alignment_quality(
-                outcome.aligned[..., cols], outcome.mean[cols], space
+                outcome.aligned[..., cols], outcome.mean[..., cols], space
             )
         values["speed peak"] = speed_peak(outcome.mean)
         results[method] = values
