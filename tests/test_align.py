@@ -394,3 +394,12 @@ def test_top_level_align_is_the_function_even_after_submodule_imports():
     from sk_rtw import align as top_level
 
     assert callable(top_level) and top_level is sk_rtw.align
+
+
+def test_quaternion_mean_and_aligned_series_have_no_sign_flips():
+    data = make_warped_signals("quaternion", 3, 40, 0, amplitude=1.2)
+    rng = np.random.default_rng(1)
+    flipped = data.signals * np.where(rng.random((3, 40)) < 0.5, -1.0, 1.0)[..., None]
+    result = align(flipped, manifold="quaternion", n_epochs=2, random_state=0)
+    assert np.all((result.mean[1:] * result.mean[:-1]).sum(-1) > 0)
+    assert np.all((result.aligned[:, 1:] * result.aligned[:, :-1]).sum(-1) > 0)

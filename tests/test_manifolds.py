@@ -335,3 +335,29 @@ def test_sphere_series_expansions_match_closed_forms_at_the_switch(squared_norm)
     np.testing.assert_allclose(
         M.log(p, x), [0.0, math.atan2(x[1], x[0]), 0.0], rtol=2e-15, atol=1e-25
     )
+
+
+def test_continuous_removes_quaternion_sign_flips_and_nothing_else(rng):
+    Q = Quaternion()
+    series = np.stack([random_walk_on(Q, 30, seed) for seed in range(3)])
+    flipped = series * np.where(rng.random((3, 30)) < 0.5, -1.0, 1.0)[..., None]
+    fixed = Q.continuous(flipped)
+    assert np.all((fixed[:, 1:] * fixed[:, :-1]).sum(-1) > 0)
+    np.testing.assert_allclose(np.abs(fixed), np.abs(flipped))
+    np.testing.assert_allclose(Q.dist(fixed, series), 0.0, atol=1e-7)
+    pose = Product((Euclidean(3), Q))
+    poses = np.concatenate([rng.standard_normal((3, 30, 3)), flipped], axis=-1)
+    fixed_pose = pose.continuous(poses)
+    np.testing.assert_array_equal(fixed_pose[..., :3], poses[..., :3])
+    np.testing.assert_allclose(fixed_pose[..., 3:], fixed)
+    X = rng.standard_normal((2, 10, 3))
+    np.testing.assert_array_equal(Sphere(2).continuous(X), X)
+
+
+def random_walk_on(manifold, length, seed, step=0.3):
+    rng = np.random.default_rng(seed)
+    points = [manifold.random_point((), rng.integers(1 << 30))]
+    for _ in range(length - 1):
+        v = manifold.random_tangent(points[-1], step, rng.integers(1 << 30))
+        points.append(manifold.exp(points[-1], v))
+    return np.stack(points)

@@ -376,8 +376,8 @@ def align(
     with torch.no_grad():
         _, warps, aligned, mean = problem.forward(model)
     return Alignment(
-        mean=mean.cpu().numpy(),
-        aligned=aligned.cpu().numpy(),
+        mean=collection.manifold.continuous(mean.cpu().numpy()),
+        aligned=collection.manifold.continuous(aligned.cpu().numpy()),
         warps=warps.cpu().numpy(),
         loss_history=history,
         best_epoch=best_epoch,

@@ -48,8 +48,8 @@ def make_result(
     aligned = np.stack([s[i] for s, i in zip(series, indices, strict=True)])
     scale = np.array([max(len(s) - 1, 1) for s in series], dtype=float)[:, None]
     return MultipleAlignment(
-        mean=mean,
-        aligned=aligned,
+        mean=manifold.continuous(mean),
+        aligned=manifold.continuous(aligned),
         indices=indices,
         warps=indices / scale,
         cost=float(cost),

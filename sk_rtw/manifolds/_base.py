@@ -278,6 +278,25 @@ class Manifold(ABC):
                     "onto the manifold."
                 )
 
+    def continuous(self, series: Any) -> np.ndarray:
+        """Representatives of a series that do not jump between equivalent points.
+
+        Only spaces whose points have several coordinate representations change
+        anything: for :class:`Quaternion` every sample takes the sign that keeps it in
+        the hemisphere of the previous one, so a mean trajectory does not flip between
+        ``q`` and ``-q``. Distances and means are unaffected.
+
+        Parameters
+        ----------
+        series : array-like of shape (..., T, *point_shape)
+            Series along the axis just before the point axes.
+
+        Returns
+        -------
+        series : ndarray of shape (..., T, *point_shape)
+        """
+        return np.asarray(series, dtype=np.float64)
+
     def random_point(self, n_points: int | tuple[int, ...] = (), random_state=None):
         """Random points, for tests and examples.
 

@@ -62,6 +62,18 @@ class Product(Manifold):
             offset += size
         return tuple(segments)
 
+    def continuous(self, series):
+        series = np.array(series, dtype=np.float64)
+        bounds = np.cumsum([0, *self._sizes])
+        for factor, start, stop in zip(self.factors, bounds[:-1], bounds[1:], strict=True):
+            part = series[..., start:stop]
+            part = part.reshape(*part.shape[:-1], *factor.point_shape)
+            fixed = factor.continuous(part)
+            series[..., start:stop] = fixed.reshape(
+                *fixed.shape[: fixed.ndim - factor.point_ndim], -1
+            )
+        return series
+
     def _split(self, x):
         parts = torch.split(x, self._sizes, dim=-1)
         return [

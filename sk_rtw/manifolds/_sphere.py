@@ -137,6 +137,15 @@ class Quaternion(Sphere):
     def __repr__(self) -> str:
         return "Quaternion()"
 
+    def continuous(self, series):
+        series = np.array(series, dtype=np.float64)
+        if series.ndim < 2 or series.shape[-2] < 2:
+            return series
+        dots = (series[..., 1:, :] * series[..., :-1, :]).sum(-1)
+        signs = np.cumprod(np.where(dots < 0, -1.0, 1.0), axis=-1)
+        series[..., 1:, :] *= signs[..., None]
+        return series
+
     def _log(self, p, x):
         sign = torch.where((p * x).sum(-1, keepdim=True) < 0, -1.0, 1.0)
         return _sphere_log(p, sign * x)
