@@ -6,12 +6,11 @@ from typing import Any
 
 import numpy as np
 
-from ..dtw import _kernels
 from ..dtw._dtw import _check_window, point_cost_matrix
 from ..manifolds import Quaternion
 from ..utils import check_series, check_series_collection
 from ._mmddtw import nd_dtw
-from ._result import MultipleAlignment, make_result
+from ._result import MultipleAlignment, make_result, path_from_costs
 
 COSTS = ("geodesic", "dot")
 
@@ -70,10 +69,7 @@ def qdtw(
     """
     x, _ = check_series(x, Quaternion(), name="x", min_length=1)
     y, _ = check_series(y, Quaternion(), name="y", min_length=1)
-    D = _kernels.accumulated_cost(quaternion_cost_matrix(x, y, cost), _check_window(window))
-    if not np.isfinite(D[-1, -1]):
-        raise ValueError("the Sakoe–Chiba window is too narrow to connect the series ends")
-    return np.asarray(_kernels.backtrack(D), dtype=np.int64).reshape(-1, 2), float(D[-1, -1])
+    return path_from_costs(quaternion_cost_matrix(x, y, cost), _check_window(window))
 
 
 def qdtw_align(

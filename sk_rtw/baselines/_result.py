@@ -57,14 +57,19 @@ def make_result(
     )
 
 
+def path_from_costs(cost: np.ndarray, window: float) -> tuple[np.ndarray, float]:
+    """Optimal DTW path ``(L, 2)`` through a point-cost matrix ``(T_x, T_y)``, and its cost."""
+    D = _kernels.accumulated_cost(cost, window)
+    if not np.isfinite(D[-1, -1]):
+        raise ValueError("the Sakoe–Chiba window is too narrow to connect the series ends")
+    return np.asarray(_kernels.backtrack(D), dtype=np.int64).reshape(-1, 2), float(D[-1, -1])
+
+
 def dtw_path_array(
     x: np.ndarray, y: np.ndarray, manifold: Manifold, window: float, squared: bool
 ) -> tuple[np.ndarray, float]:
     """Optimal DTW path ``(L, 2)`` between two validated series, and its cost."""
-    D = _kernels.accumulated_cost(point_cost_matrix(x, y, manifold, squared), window)
-    if not np.isfinite(D[-1, -1]):
-        raise ValueError("the Sakoe–Chiba window is too narrow to connect the series ends")
-    return np.asarray(_kernels.backtrack(D), dtype=np.int64).reshape(-1, 2), float(D[-1, -1])
+    return path_from_costs(point_cost_matrix(x, y, manifold, squared), window)
 
 
 def grouped_mean(
