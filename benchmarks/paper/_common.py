@@ -103,6 +103,17 @@ def score(outcome: Outcome, X, manifold, original=None) -> dict[str, float]:
     return values
 
 
+def evaluate(
+    X, manifold, methods, *, epochs: int, seed: int, device: str
+) -> dict[str, dict[str, float]]:
+    """Scores of naive interpolation ("unaligned") and of every method on the series X."""
+    results = {"unaligned": score(unaligned(X, manifold), X, manifold)}
+    for method in methods:
+        outcome = run_method(method, X, manifold, epochs=epochs, seed=seed, device=device)
+        results[method] = score(outcome, X, manifold)
+    return results
+
+
 def machine() -> str:
     return (
         f"{platform.machine()}, {torch.get_num_threads()} torch threads, "

@@ -27,10 +27,8 @@ if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
 from benchmarks.paper._common import (  # noqa: E402
+    evaluate,
     markdown_table,
-    run_method,
-    score,
-    unaligned,
     write_markdown,
 )
 from benchmarks.paper._data import (  # noqa: E402
@@ -44,15 +42,6 @@ from sk_rtw.manifolds import Quaternion  # noqa: E402
 
 PAPER = {"qdtw": (0.0359, 0.0338), "rtw": (0.0339, 0.0338)}  # Table V: BL, AQ
 COLUMNS = ("BL", "AQ", "seconds")
-
-
-def evaluate(X, methods, epochs, seed, device) -> dict[str, dict[str, float]]:
-    M = Quaternion()
-    out = {"unaligned": score(unaligned(X, M), X, M)}
-    for method in methods:
-        outcome = run_method(method, X, M, epochs=epochs, seed=seed, device=device)
-        out[method] = score(outcome, X, M)
-    return out
 
 
 def main(argv=None) -> None:
@@ -80,16 +69,20 @@ def main(argv=None) -> None:
     letters = rcfs_letter(root, args.letter)[: args.n_signals, :: args.step]
     X = letters_on_s3(letters, args.scale)
     rcfs = {
-        m: [v] for m, v in evaluate(X, args.methods, args.epochs, args.seed, args.device).items()
+        m: [v]
+        for m, v in evaluate(
+            X, Quaternion(), args.methods, epochs=args.epochs, seed=args.seed, device=args.device
+        ).items()
     }
     print(f"RCFS {args.letter}: done", file=sys.stderr, flush=True)
 
     lasa = {m: [] for m in ("unaligned", *args.methods)}
     for shape in shapes:
         X = rlasa_quaternions(root, shape)[:, :: args.lasa_step]
-        for method, values in evaluate(
-            X, args.methods, args.epochs, args.seed, args.device
-        ).items():
+        scores = evaluate(
+            X, Quaternion(), args.methods, epochs=args.epochs, seed=args.seed, device=args.device
+        )
+        for method, values in scores.items():
             lasa[method].append(values)
         print(f"R-LASA {shape}: done", file=sys.stderr, flush=True)
 

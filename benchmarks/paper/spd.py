@@ -35,10 +35,8 @@ if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
 from benchmarks.paper._common import (  # noqa: E402
+    evaluate,
     markdown_table,
-    run_method,
-    score,
-    unaligned,
     write_markdown,
 )
 from benchmarks.paper._data import (  # noqa: E402
@@ -72,14 +70,11 @@ def robot_signals(letters: np.ndarray, size: int) -> np.ndarray:
     return planar_arm_mass_matrix(q, lengths, np.full(n_links, 1.0 / n_links))
 
 
-def evaluate(X, methods, epochs, seed, device) -> dict[str, dict[str, float]]:
-    M = SPD(X.shape[-1])
-    M.validate(X)
-    out = {"unaligned": score(unaligned(X, M), X, M)}
-    for method in methods:
-        outcome = run_method(method, X, M, epochs=epochs, seed=seed, device=device)
-        out[method] = score(outcome, X, M)
-    return out
+def spd_of(X) -> SPD:
+    """The SPD manifold of the matrices in X, after checking that they are SPD."""
+    manifold = SPD(X.shape[-1])
+    manifold.validate(X)
+    return manifold
 
 
 def main(argv=None) -> None:
@@ -115,7 +110,10 @@ def main(argv=None) -> None:
         epochs = args.large_epochs if large else args.epochs
         X = robot_signals(letters[:, ::step], size)
         results = {
-            m: [v] for m, v in evaluate(X, args.methods, epochs, args.seed, args.device).items()
+            m: [v]
+            for m, v in evaluate(
+                X, spd_of(X), args.methods, epochs=epochs, seed=args.seed, device=args.device
+            ).items()
         }
         what = "manipulability of a 3-link arm" if size == 2 else f"mass matrix, {size} links"
         title = f"SPD({size}): {what}, N = {len(X)}, T = {X.shape[1]}, {epochs} epochs"
@@ -125,9 +123,10 @@ def main(argv=None) -> None:
     lasa = {m: [] for m in ("unaligned", *args.methods)}
     for shape in shapes:
         X = rlasa_spd(root, shape)[: args.lasa_signals, :: args.lasa_step]
-        for method, values in evaluate(
-            X, args.methods, args.epochs, args.seed, args.device
-        ).items():
+        scores = evaluate(
+            X, spd_of(X), args.methods, epochs=args.epochs, seed=args.seed, device=args.device
+        )
+        for method, values in scores.items():
             lasa[method].append(values)
         print(f"R-LASA {shape}: done", file=sys.stderr, flush=True)
     title = (
