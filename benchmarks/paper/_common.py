@@ -14,9 +14,9 @@ import numpy as np
 import torch
 
 from sk_rtw import align, metrics
+from sk_rtw.align import METHODS
 from sk_rtw.baselines import dba_average, mmddtw_align, pdtw_average, qdtw_align
 
-ENGINE_METHODS = ("rtw", "ttw", "ntw")
 LABELS = {
     "rtw": "RTW",
     "ttw": "TTW",
@@ -53,7 +53,7 @@ def run_method(
 ) -> Outcome:
     """Run one method of the paper's tables (or DBA) on the series ``X``."""
     start = time.perf_counter()
-    if method in ENGINE_METHODS:
+    if method in METHODS:
         r = align(
             X,
             manifold=manifold,
