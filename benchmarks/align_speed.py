@@ -1,171 +1,173 @@
-"""Speed and memory of ``sk_rtw.align`` on S^1 signals of length T = 100.
+"""Speed and memory of ``sk_rtw.align`` next to aeon's DBA, on the same data in one run.
 
 Usage::
 
-    python benchmarks/align_speed.py                 # everything below, about 15 min on 2 cores
-    python benchmarks/align_speed.py --quick         # fewer epochs, no N = 120 full fits
-    python benchmarks/align_speed.py --device cuda   # on a GPU
+    python benchmarks/align_speed.py                  # everything, about 10 min on 2 cores
+    python benchmarks/align_speed.py --skip-large     # without the 2,000-series class
+    python benchmarks/align_speed.py --device cuda    # on a GPU (adds N = 2000 per epoch)
 
 Prints
-1. seconds per epoch and per full fit (256 epochs) for N in {4, 30, 120} and each method,
-   at the default output length Z = min(N, 4) T;
-2. seconds per epoch of RTW with N = 30 at Z in {T, 4T, 30T} (30T is the paper's N T);
-3. peak memory and seconds per epoch of RTW for one class of 2,000 series (default Z),
-   measured in a fresh process.
-The per-epoch cost should grow linearly in N and Z: the last column divides by N Z.
-Full fits are timed end to end (validation, optimisation, final forward); with ``--quick``
-or ``--project-large`` the N = 120 fits are projected from the per-epoch time (marked ~).
+1. one full fit (256 epochs, product defaults) of RTW, TTW and NTW on N = 30 Euclidean
+   warped signals of length T = 100, and aeon's DBA (``elastic_barycenter_average`` with
+   DTW) on the same signals; the ratio to DBA is the number to compare across machines;
+2. milliseconds per epoch against N (4, 30, 120) for each method, on Euclidean and on S^1
+   data, T = 100, default output length;
+3. one class of 2,000 S^1 series of length 100: a full RTW fit (time) and the peak memory of
+   an RTW and an NTW fit, each in a fresh process.
+
+Timings are the median of ``--repeats`` runs after a warm-up (this machine's noise is
+large: compare ratios, not absolute seconds). Per-epoch times are
+``(fit(E) - fit(0)) / E``: a fit's fixed cost (validation, network set-up, final pass) is
+left out. Only the public API is used, so the script also measures older versions.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import platform
+import statistics
 import subprocess
 import sys
 import time
 
+import numpy as np
 import torch
 
-from sk_rtw.align import align
-from sk_rtw.align._engine import _build_warps, _Problem, resolve_config
+from sk_rtw import align
 from sk_rtw.datasets import make_warped_signals
-from sk_rtw.utils import check_series_collection
 
 T = 100
-PAPER_CPU_SECONDS = {4: 8.4883, 30: 103.1399}  # RTW, AMD Ryzen 5 3500U (paper, Tables III/IV)
+METHODS = ("rtw", "ttw", "ntw")
 
 
-def epoch_seconds(signals, method, output_length, device, repeats=5):
-    """Mean wall time of one optimisation epoch (forward, backward, Adam step)."""
-    collection = check_series_collection(signals, "sphere")
-    config = resolve_config(
-        method,
-        len(signals),
-        T,
-        output_length=output_length,
-        n_epochs=1,
-        learning_rate=0.01,
-        sinc_window=None,
-        loss_window=None,
-        loss_step=None,
-        penalty=None,
-        device=device,
-        method_options={},
+def machine(device: str) -> str:
+    name = platform.processor() or platform.machine()
+    if device.startswith("cuda") and torch.cuda.is_available():
+        name += f", GPU {torch.cuda.get_device_name(0)}"
+    return (
+        f"{name}, {os.cpu_count()} cores, {torch.get_num_threads()} torch threads, "
+        f"torch {torch.__version__}, device {device}"
     )
-    model = _build_warps(config, len(signals)).to(device)
-    problem = _Problem(collection, config)
-    optimiser = torch.optim.Adam(model.parameters(), lr=0.01)
 
-    def step():
-        optimiser.zero_grad()
-        loss, *_ = problem.forward(model)
-        loss.backward()
-        optimiser.step()
 
-    step()  # warm-up
-    if device != "cpu":
-        torch.cuda.synchronize()
-    start = time.perf_counter()
+def timed(fn, repeats: int) -> float:
+    """Median wall time of ``fn()`` over ``repeats`` runs (after one warm-up run)."""
+    fn()
+    times = []
     for _ in range(repeats):
-        step()
-    if device != "cpu":
-        torch.cuda.synchronize()
-    return (time.perf_counter() - start) / repeats
+        start = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - start)
+    return statistics.median(times)
 
 
-def memory_probe(n_signals: int, device: str) -> dict:
-    """Run one RTW epoch for a large class in a child process; report its peak memory."""
-    code = f"""
-import json, resource, time, torch
+def fit(X, manifold, method, epochs, device):
+    return align(X, manifold=manifold, method=method, n_epochs=epochs, random_state=0,
+                 device=device)  # fmt: skip
+
+
+def dba_seconds(X: np.ndarray, repeats: int) -> float:
+    from aeon.clustering.averaging import elastic_barycenter_average
+
+    channels_first = np.swapaxes(X, 1, 2)
+    return timed(
+        lambda: elastic_barycenter_average(channels_first, distance="dtw", random_state=0),
+        repeats,
+    )
+
+
+def section_fits(device: str, repeats: int) -> None:
+    X = np.asarray(make_warped_signals("euclidean", 30, T, random_state=0).signals)
+    dba = dba_seconds(X, repeats)
+    print(f"\n1. Full fits, N = 30 Euclidean series, T = {T}, 256 epochs, defaults")
+    print(f"{'method':>8} {'seconds':>9} {'x DBA':>7}")
+    print(f"{'aeon DBA':>8} {dba:>9.3f} {1.0:>7.1f}")
+    for method in METHODS:
+        seconds = timed(lambda m=method: fit(X, "euclidean", m, 256, device), repeats)
+        print(f"{method:>8} {seconds:>9.3f} {seconds / dba:>7.1f}", flush=True)
+
+
+def per_epoch_ms(X, manifold, method, device, epochs, repeats) -> float:
+    full = timed(lambda: fit(X, manifold, method, epochs, device), repeats)
+    setup = timed(lambda: fit(X, manifold, method, 0, device), repeats)
+    return max(full - setup, 0.0) / epochs * 1e3
+
+
+def section_epochs(device: str, repeats: int, sizes) -> None:
+    print(f"\n2. Milliseconds per epoch, T = {T}, default Z = min(N, 4) T")
+    print(f"{'space':>9} {'N':>5} " + " ".join(f"{m:>8}" for m in METHODS))
+    for manifold in ("euclidean", "sphere"):
+        for n in sizes:
+            X = np.asarray(make_warped_signals(manifold, n, T, random_state=0).signals)
+            epochs = 16 if n >= 1000 else 32
+            row = [per_epoch_ms(X, manifold, m, device, epochs, repeats) for m in METHODS]
+            name = "S^1" if manifold == "sphere" else manifold
+            print(f"{name:>9} {n:>5} " + " ".join(f"{v:>8.2f}" for v in row), flush=True)
+
+
+PROBE = """
+import json, resource, sys, time, torch
 import numpy as np
+from sk_rtw import align
 from sk_rtw.datasets import make_warped_signals
-import benchmarks.align_speed as b
-signals = make_warped_signals("sphere", {n_signals}, {T}, 0).signals
-base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-seconds = b.epoch_seconds(signals, "rtw", None, "{device}", repeats=2)
-peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-gpu = torch.cuda.max_memory_allocated() / 2**20 if "{device}" != "cpu" else 0.0
-print(json.dumps({{"seconds": seconds, "peak_mib": peak / 1024, "base_mib": base / 1024,
-                  "gpu_mib": gpu}}))
+method, n, epochs, device = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), sys.argv[4]
+X = np.asarray(make_warped_signals("sphere", n, 100, random_state=0).signals)
+before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+start = time.perf_counter()
+align(X, manifold="sphere", method=method, n_epochs=epochs, random_state=0, device=device)
+seconds = time.perf_counter() - start
+peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+gpu = torch.cuda.max_memory_allocated() / 2**20 if device.startswith("cuda") else 0.0
+print(json.dumps({"seconds": seconds, "peak_mib": peak, "before_mib": before, "gpu_mib": gpu}))
 """
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+
+
+def probe(method: str, n: int, epochs: int, device: str) -> dict:
+    """One fit in a fresh process: seconds and peak resident (and GPU) memory."""
+    out = subprocess.run(
+        [sys.executable, "-c", PROBE, method, str(n), str(epochs), device],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
-def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true")
-    parser.add_argument(
-        "--project-large",
-        action="store_true",
-        help="project N = 120 full fits from the per-epoch time",
-    )
-    parser.add_argument("--epochs", type=int, default=256)
-    parser.add_argument("--device", default="cpu")
-    parser.add_argument("--threads", type=int, default=None)
-    args = parser.parse_args(argv)
-    if args.threads:
-        torch.set_num_threads(args.threads)
-    epochs = 32 if args.quick else args.epochs
-    project_large = args.quick or args.project_large
-
-    print(
-        f"machine: {platform.machine()}, {torch.get_num_threads()} torch threads, "
-        f"device {args.device}, torch {torch.__version__}"
-    )
-    # warm up torch's thread pool and allocator once, so the first row is not penalised
-    epoch_seconds(make_warped_signals("sphere", 4, T, 1).signals, "rtw", 4 * T, args.device)
-    print(f"\n1. S^1, T = {T}, Z = min(N, 4) T, full fit = {epochs} epochs")
-    print(
-        f"{'N':>4} {'method':>6} {'Z':>5} {'s/epoch':>9} {'s/fit':>9} "
-        f"{'paper s/fit':>11} {'us/(N Z)':>9}"
-    )
-    for n in (4, 30, 120):
-        signals = make_warped_signals("sphere", n, T, 0).signals
-        z = min(n, 4) * T
-        for method in ("rtw", "ttw", "ntw"):
-            per_epoch = epoch_seconds(signals, method, z, args.device)
-            if n == 120 and project_large:
-                fit = f"~{per_epoch * epochs:.1f}"
-            else:
-                start = time.perf_counter()
-                align(
-                    signals,
-                    manifold="sphere",
-                    method=method,
-                    n_epochs=epochs,
-                    random_state=0,
-                    device=args.device,
-                )
-                fit = f"{time.perf_counter() - start:.1f}"
-            paper = PAPER_CPU_SECONDS.get(n) if method == "rtw" else None
-            paper_text = f"{paper:.1f}" if paper else "-"
-            print(
-                f"{n:>4} {method:>6} {z:>5} {per_epoch:>9.4f} {fit:>9} {paper_text:>11} "
-                f"{per_epoch / (n * z) * 1e6:>9.3f}",
-                flush=True,
-            )
-
-    print("\n2. RTW, N = 30, per epoch against the output length")
-    print(f"{'Z':>6} {'s/epoch':>9} {'us/(N Z)':>9}")
-    signals = make_warped_signals("sphere", 30, T, 0).signals
-    for factor in (1, 4, 30):
-        per_epoch = epoch_seconds(signals, "rtw", factor * T, args.device, repeats=3)
+def section_large(device: str) -> None:
+    n = 2000
+    print(f"\n3. One class of {n} S^1 series, T = {T}, Z = {4 * T}, each in a fresh process")
+    for method, epochs in (("rtw", 256), ("ntw", 4)):
+        result = probe(method, n, epochs, device)
+        gpu = f", GPU peak {result['gpu_mib']:.0f} MiB" if result["gpu_mib"] else ""
+        what = "full fit" if epochs == 256 else f"{epochs} epochs (memory)"
         print(
-            f"{factor * T:>6} {per_epoch:>9.4f} {per_epoch / (30 * factor * T) * 1e6:>9.3f}",
+            f"   {method}: {what} {result['seconds']:.1f} s, peak resident memory "
+            f"{result['peak_mib']:.0f} MiB ({result['before_mib']:.0f} MiB before the fit)"
+            f"{gpu}",
             flush=True,
         )
 
-    print("\n3. RTW, one class of 2,000 series of length 100 (default Z = 4 T = 400)")
-    probe = memory_probe(2000, args.device)
-    print(
-        f"   peak RSS {probe['peak_mib']:.0f} MiB (process before the fit: "
-        f"{probe['base_mib']:.0f} MiB), GPU peak {probe['gpu_mib']:.0f} MiB, "
-        f"{probe['seconds']:.2f} s/epoch -> ~{probe['seconds'] * 256 / 60:.1f} min "
-        "for 256 epochs"
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(
+        description=__doc__.splitlines()[0],
+        epilog=__doc__.split("Usage::")[1].split("Prints")[0],
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
+    parser.add_argument("--device", default="cpu", help="torch device, e.g. cuda")
+    parser.add_argument("--threads", type=int, default=2, help="torch threads (default 2)")
+    parser.add_argument("--repeats", type=int, default=3, help="timed runs per number")
+    parser.add_argument("--skip-large", action="store_true", help="skip the 2,000-series class")
+    args = parser.parse_args(argv)
+    torch.set_num_threads(args.threads)
+    print(f"machine: {machine(args.device)}")
+    section_fits(args.device, args.repeats)
+    sizes = (4, 30, 120, 2000) if args.device.startswith("cuda") else (4, 30, 120)
+    section_epochs(args.device, args.repeats, sizes)
+    if not args.skip_large:
+        section_large(args.device)
 
 
 if __name__ == "__main__":

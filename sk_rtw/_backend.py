@@ -64,8 +64,31 @@ def _to_numpy(out: Any) -> Any:
     return out
 
 
+def sum_last(x: torch.Tensor, n_axes: int = 1, keepdim: bool = False) -> torch.Tensor:
+    """Sum over the last ``n_axes`` axes, as a matrix-vector product with ones.
+
+    Same value as ``x.sum(dim=(-n_axes, ..., -1))``, but torch's CPU reductions over a
+    short last axis (the 2 to 16 coordinates of a point) are 5 to 15 times slower than a
+    product with a ones vector, and the geometry does them on every sample of every epoch.
+    """
+    if n_axes > 1:
+        x = x.reshape(*x.shape[: x.ndim - n_axes], -1)
+    out = x @ torch.ones(x.shape[-1], dtype=x.dtype, device=x.device)
+    return out.unsqueeze(-1) if keepdim else out
+
+
+def inner(a: torch.Tensor, b: torch.Tensor, keepdim: bool = False) -> torch.Tensor:
+    """Inner product over the last axis, broadcast over the others."""
+    return sum_last(a * b, keepdim=keepdim)
+
+
 def safe_norm(v: torch.Tensor, dim: int | tuple[int, ...] = -1) -> torch.Tensor:
     """Euclidean norm whose gradient at zero is zero instead of NaN."""
-    sq = (v * v).sum(dim=dim)
+    if dim == -1:
+        sq = sum_last(v * v)
+    elif dim == (-2, -1):
+        sq = sum_last(v * v, n_axes=2)
+    else:
+        sq = (v * v).sum(dim=dim)
     positive = sq > 0
     return torch.where(positive, torch.sqrt(torch.where(positive, sq, torch.ones_like(sq))), 0.0)

@@ -11,7 +11,14 @@ import torch
 
 from sk_rtw.align import align, tangent_sinc_interpolate
 from sk_rtw.align._loss import monotonicity_penalty, window_weights
-from sk_rtw.align._warps import HouseholderBasis, NeuralWarps, SineWarps, unit_time
+from sk_rtw.align._training import Trainer
+from sk_rtw.align._warps import (
+    HouseholderBasis,
+    NeuralWarps,
+    SineWarps,
+    resample_linear,
+    unit_time,
+)
 from sk_rtw.datasets import make_warped_signals
 from sk_rtw.manifolds import SPD, Euclidean, Quaternion, Sphere
 from sk_rtw.metrics import alignment_quality, barycenter_loss, restoration_accuracy
@@ -39,7 +46,7 @@ def reference_windowed_sinc(x, positions, window):
     return np.array(out)
 
 
-def interpolate(manifold, x, warps, window=10, refinements=2):
+def interpolate(manifold, x, warps, window=10, refinements=0):
     data = torch.as_tensor(np.asarray(x))[None]
     w = torch.as_tensor(np.asarray(warps), dtype=torch.float64)[None]
     return tangent_sinc_interpolate(
@@ -176,6 +183,37 @@ def test_neural_warps_match_the_paper_architecture():
     np.testing.assert_array_equal(zero(zhat).detach().numpy(), zhat.expand(n, -1).numpy())
 
 
+def test_linear_resampling_equals_numpy_interp(rng):
+    values = torch.as_tensor(rng.standard_normal((9, 3)))
+    times = torch.as_tensor(np.concatenate([[0.0, 1.0], rng.uniform(0, 1, 40)]))
+    knots = np.linspace(0, 1, 9)
+    expected = np.stack([np.interp(times, knots, values[:, j]) for j in range(3)], axis=1)
+    np.testing.assert_allclose(resample_linear(values, times).numpy(), expected, atol=1e-14)
+
+
+def test_warps_on_knots_interpolate_the_network_between_them():
+    torch.manual_seed(0)
+    exact = NeuralWarps(5, hidden=32, knots=None)
+    knotted = NeuralWarps(5, hidden=32, knots=11)
+    knotted.load_state_dict(exact.state_dict())
+    zhat = unit_time(101)
+    at_knots = unit_time(11)
+    # at the knot times both are the same function
+    np.testing.assert_allclose(
+        knotted.offsets(zhat)[::10].detach().numpy(),
+        exact.offsets(at_knots).detach().numpy(),
+        atol=1e-14,
+    )
+    raw = knotted(zhat).detach()
+    np.testing.assert_array_equal(raw[:, 0].numpy(), 0.0)  # boundary constraint exact
+    np.testing.assert_array_equal(raw[:, -1].numpy(), 1.0)
+    np.testing.assert_allclose(raw.mean(0).numpy(), zhat.numpy(), atol=1e-12)
+    # at least as many knots as output times: the network at every output time
+    full = NeuralWarps(5, hidden=32, knots=200)
+    full.load_state_dict(exact.state_dict())
+    np.testing.assert_array_equal(full(zhat).detach().numpy(), exact(zhat).detach().numpy())
+
+
 def test_sine_warps_are_centred_monotone_and_exact_at_the_ends():
     model = SineWarps(5, n_components=4)
     with torch.no_grad():
@@ -293,7 +331,8 @@ def test_first_loss_is_the_papers_loss_at_identity_warps():
         data.signals, manifold=M, method="ntw", n_epochs=1, output_length=45, mean_iterations=20
     )
     grid = np.linspace(0, 1, 45)
-    resampled = np.stack([interpolate(M, x, grid, None) for x in data.signals])
+    refinements = result.config.tangent_refinements
+    resampled = np.stack([interpolate(M, x, grid, None, refinements) for x in data.signals])
     mean = M.mean(resampled)
     expected = M.dist(resampled, mean[None]).mean()
     assert result.loss_history[0] == pytest.approx(expected, rel=1e-9)
@@ -365,6 +404,8 @@ def test_very_short_series_work():
         ({"loss_step": 0}, ValueError, "loss_step"),
         ({"penalty": -1.0}, ValueError, "penalty"),
         ({"n_components": 0}, ValueError, "n_components"),
+        ({"warp_knots": 1}, ValueError, "warp_knots"),
+        ({"tangent_refinements": -1}, ValueError, "tangent_refinements"),
         ({"bogus": 1}, TypeError, "bogus"),
     ],
 )
@@ -378,6 +419,37 @@ def test_bad_data():
         align(np.array([[0.0, np.nan, 1.0], [0.0, 1.0, 2.0]]))
     with pytest.raises(ValueError, match="not a point"):
         align(np.ones((2, 5, 3)), manifold="sphere")
+
+
+def test_returned_warps_are_those_of_the_best_epoch():
+    """The final pass runs with the parameters of the lowest recorded loss."""
+    data = make_warped_signals("sphere", 4, 40, 2)
+    result = align(data.signals, manifold="sphere", n_epochs=40, random_state=0)
+    again = align(
+        data.signals,
+        manifold="sphere",
+        n_epochs=result.best_epoch + 1,
+        random_state=0,
+    )  # the same trajectory, stopped right after the best epoch was recorded
+    np.testing.assert_allclose(again.warps, result.warps, atol=1e-12)
+    assert result.loss_history[result.best_epoch] == result.loss_history.min()
+
+
+def test_trainer_raises_on_a_non_finite_loss():
+    weight = torch.nn.Parameter(torch.ones(3))
+    trainer = Trainer(lambda: (weight * 1e308 * 10).sum(), [weight], 5, 0.1)
+    with pytest.raises(FloatingPointError, match="epoch 0"):
+        trainer.run(lambda done, history: None, 2)
+
+
+def test_trainer_keeps_the_lowest_loss_parameters():
+    weight = torch.nn.Parameter(torch.tensor([3.0]))
+    # a loss with its minimum at 1; a large rate makes Adam overshoot and come back
+    trainer = Trainer(lambda: (weight - 1.0).abs().sum(), [weight], 30, 1.5)
+    best = trainer.run(lambda done, history: None, 10)
+    history = trainer.history.numpy()
+    assert best == int(np.argmin(history))
+    assert abs(float(weight) - 1.0) == pytest.approx(history[best])
 
 
 def test_verbose_reports_progress(capsys):

@@ -361,3 +361,17 @@ def random_walk_on(manifold, length, seed, step=0.3):
         v = manifold.random_tangent(points[-1], step, rng.integers(1 << 30))
         points.append(manifold.exp(points[-1], v))
     return np.stack(points)
+
+
+@pytest.mark.parametrize("shape", [(7, 2), (3, 5, 3), (4, 1), (2, 3, 4, 4)])
+def test_sum_last_and_inner_equal_torch_sums(shape):
+    from sk_rtw._backend import inner, sum_last
+
+    x = torch.randn(*shape, dtype=torch.float64, requires_grad=True)
+    y = torch.randn(*shape, dtype=torch.float64)
+    torch.testing.assert_close(sum_last(x), x.sum(-1))
+    torch.testing.assert_close(sum_last(x, keepdim=True), x.sum(-1, keepdim=True))
+    torch.testing.assert_close(sum_last(x, n_axes=2), x.sum((-2, -1)))
+    torch.testing.assert_close(inner(x, y), (x * y).sum(-1))
+    (grad,) = torch.autograd.grad(inner(x, y).sum(), x)
+    torch.testing.assert_close(grad, y)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import argparse
+import json
 import platform
 import shlex
 import sys
@@ -29,6 +31,27 @@ LABELS = {
     "unaligned": "unaligned",
     "interpolation": "interpolation",
 }
+
+
+#: Extra keyword arguments of ``sk_rtw.align`` for TTW, NTW and RTW (``--options``).
+ENGINE_OPTIONS: dict = {}
+
+
+def add_engine_options(parser: argparse.ArgumentParser) -> None:
+    """The ``--options`` argument: engine options as JSON, applied by :func:`run_method`."""
+    parser.add_argument(
+        "--options",
+        type=json.loads,
+        default={},
+        help="extra sk_rtw.align options for TTW/NTW/RTW as JSON, e.g. "
+        '\'{"warp_knots": null, "tangent_refinements": 2}\' (network at every output time, '
+        "refined tangent points)",
+    )
+
+
+def apply_engine_options(args: argparse.Namespace) -> None:
+    ENGINE_OPTIONS.clear()
+    ENGINE_OPTIONS.update(args.options)
 
 
 @dataclass
@@ -62,6 +85,7 @@ def run_method(
             output_length=output_length,
             random_state=seed,
             device=device,
+            **ENGINE_OPTIONS,
         )
     elif method == "mmddtw":
         r = mmddtw_align(X, manifold)
@@ -164,6 +188,8 @@ def markdown_table(
 def write_markdown(path: str | None, title: str, intro: str, sections: dict[str, str]) -> None:
     """Print the tables and, with ``path``, write them as a Markdown page."""
     body = [f"# {title}", "", intro.strip(), "", f"Command: `{command_line()}`", ""]
+    if ENGINE_OPTIONS:
+        body += [f"Engine options for TTW/NTW/RTW: `{json.dumps(ENGINE_OPTIONS)}`.", ""]
     body += [f"Machine: {machine()}.", ""]
     for heading, text in sections.items():
         body += [f"## {heading}", "", text.strip(), ""]

@@ -31,6 +31,8 @@ if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
 from benchmarks.paper._common import (  # noqa: E402
+    add_engine_options,
+    apply_engine_options,
     markdown_table,
     run_method,
     score,
@@ -107,10 +109,12 @@ def main(argv=None) -> None:
         "--output-lengths", type=int, nargs="+", default=[None], help="Z (default: min(N, 4) T)"
     )
     parser.add_argument("--device", default="cpu")
+    add_engine_options(parser)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--markdown", help="also write the tables to this Markdown file")
     parser.add_argument("--quick", action="store_true", help="1 trial, 64 epochs")
     args = parser.parse_args(argv)
+    apply_engine_options(args)
     if args.quick:
         args.trials, args.epochs = 1, 64
     sections = {}

@@ -33,6 +33,8 @@ if str(ROOT) not in sys.path:
 
 from benchmarks.paper._common import (  # noqa: E402
     LABELS,
+    add_engine_options,
+    apply_engine_options,
     markdown_table,
     run_method,
     score,
@@ -124,10 +126,12 @@ def main(argv=None) -> None:
     parser.add_argument("--epochs", type=int, default=256)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--device", default="cpu")
+    add_engine_options(parser)
     parser.add_argument("--markdown", help="also write the tables to this Markdown file")
     parser.add_argument("--figure-dir", help="write pose_<task>.png figures here")
     parser.add_argument("--quick", action="store_true", help="64 epochs, 4 grating demos")
     args = parser.parse_args(argv)
+    apply_engine_options(args)
     root = data_dir(args.data_dir)
     if args.quick:
         args.epochs = 64

@@ -27,6 +27,8 @@ if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
 from benchmarks.paper._common import (  # noqa: E402
+    add_engine_options,
+    apply_engine_options,
     evaluate,
     markdown_table,
     write_markdown,
@@ -57,9 +59,11 @@ def main(argv=None) -> None:
     parser.add_argument("--epochs", type=int, default=256)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--device", default="cpu")
+    add_engine_options(parser)
     parser.add_argument("--markdown", help="also write the tables to this Markdown file")
     parser.add_argument("--quick", action="store_true", help="T = 100, 64 epochs, 3 shapes")
     args = parser.parse_args(argv)
+    apply_engine_options(args)
     root = data_dir(args.data_dir)
     shapes = args.shapes or rlasa_shapes(root)
     if args.quick:

@@ -17,6 +17,11 @@
 
 The returned warps are clamped to [0, 1]; ``raw`` warps (before clamping) feed the
 monotonicity penalty.
+
+``knots``: the network may be evaluated at ``knots`` equally spaced times only and its
+output interpolated linearly to the ``Z`` output times (a ReLU network of one input is
+piecewise linear anyway). The network then costs ``knots / Z`` of its full price, which is
+most of an epoch's work on a CPU; ``None`` evaluates it at every output time (the paper).
 """
 
 from __future__ import annotations
@@ -84,24 +89,69 @@ class SkipMLP(nn.Module):
         return self.readout(torch.cat([h2, h1, x], dim=-1))
 
 
+def resample_linear(values: torch.Tensor, times: torch.Tensor) -> torch.Tensor:
+    """Linear interpolation of ``values`` (J, ...) given at J equally spaced times of [0, 1].
+
+    Parameters
+    ----------
+    values : torch.Tensor, shape (J, ...)
+        Values at the times ``j / (J - 1)``, ``J >= 2``.
+    times : torch.Tensor, shape (Z,)
+        Times in [0, 1].
+
+    Returns
+    -------
+    torch.Tensor, shape (Z, ...)
+    """
+    position = times * (values.shape[0] - 1)
+    left = torch.floor(position).long().clamp(0, values.shape[0] - 2)
+    weight = (position - left).reshape(-1, *([1] * (values.ndim - 1)))
+    return torch.lerp(values[left], values[left + 1], weight.to(values.dtype))
+
+
 class NeuralWarps(nn.Module):
-    """RTW/NTW warps: identity plus ``zhat (1 - zhat)`` times a network on the basis."""
+    """RTW/NTW warps: identity plus ``zhat (1 - zhat)`` times a network on the basis.
+
+    Parameters
+    ----------
+    n_signals : int
+    hidden : int, default=512
+        Width of the two hidden layers.
+    init : {"xavier", "zeros"}, default="xavier"
+    knots : int or None, default=None
+        Evaluate the network at this many equally spaced times and interpolate linearly
+        (None: at every output time).
+    """
 
     def __init__(
-        self, n_signals: int, hidden: int = 512, init: str = "xavier", dtype=torch.float64
+        self,
+        n_signals: int,
+        hidden: int = 512,
+        init: str = "xavier",
+        knots: int | None = None,
+        dtype=torch.float64,
     ):
         super().__init__()
+        if knots is not None and knots < 2:
+            raise ValueError(f"knots must be None or an integer >= 2, got {knots!r}")
         self.n_signals = n_signals
+        self.knots = knots
         self.basis = HouseholderBasis(n_signals, dtype=dtype)
         self.phi = SkipMLP(n_signals - 1, hidden, init, dtype) if n_signals > 1 else None
+
+    def offsets(self, zhat: torch.Tensor) -> torch.Tensor:
+        """``sum_k phi_theta(zhat)_k e_{k+1}``, shape (Z, N)."""
+        if self.knots is None or self.knots >= zhat.shape[0]:
+            return self.basis.combine(self.phi(zhat))
+        grid = unit_time(self.knots, dtype=zhat.dtype, device=zhat.device)
+        return resample_linear(self.basis.combine(self.phi(grid)), zhat)
 
     def forward(self, zhat: torch.Tensor) -> torch.Tensor:
         """Raw warps, shape (N, Z)."""
         identity = zhat.expand(self.n_signals, -1)
         if self.phi is None:
             return identity
-        offsets = self.basis.combine(self.phi(zhat))  # (Z, N)
-        return identity + (zhat * (1.0 - zhat)).unsqueeze(0) * offsets.T
+        return identity + (zhat * (1.0 - zhat)).unsqueeze(0) * self.offsets(zhat).T
 
     @staticmethod
     def finalise(raw: torch.Tensor) -> torch.Tensor:

@@ -181,6 +181,7 @@ def make_warped_signals(
             data.expand(n_signals, *data.shape[1:]),
             lengths.expand(n_signals),
             torch.from_numpy(warps),
+            refinements=2,  # the warped samples are the weighted Fréchet means of the window
         ).numpy()
     return WarpedSignals(
         original=original,

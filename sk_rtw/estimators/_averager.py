@@ -42,8 +42,12 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         Sine terms of the TTW warps (TTW only).
     hidden_size : int, default=512
         Hidden width of the RTW/NTW warp network.
-    tangent_refinements : int, default=2
-        Gauss–Newton refinements of the interpolation tangent point.
+    warp_knots : int or None, default=64
+        Times at which the RTW/NTW warp network is evaluated (linear in between); None
+        evaluates it at every output time, as the paper does.
+    tangent_refinements : int, default=0
+        Gauss–Newton refinements of the interpolation tangent point (0: the centre sample
+        of each window; the paper refines it "a few" times).
     mean_iterations : int, default=5
         Gauss–Newton iterations of the mean per epoch.
     dtw_window : float in [0, 1], optional
@@ -96,7 +100,8 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         penalty: float | None = None,
         n_components: int = 8,
         hidden_size: int = 512,
-        tangent_refinements: int = 2,
+        warp_knots: int | None = 64,
+        tangent_refinements: int = 0,
         mean_iterations: int = 5,
         dtw_window: float | None = None,
         n_jobs: int | None = None,
@@ -114,6 +119,7 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         self.penalty = penalty
         self.n_components = n_components
         self.hidden_size = hidden_size
+        self.warp_knots = warp_knots
         self.tangent_refinements = tangent_refinements
         self.mean_iterations = mean_iterations
         self.dtw_window = dtw_window
@@ -193,6 +199,7 @@ class RTWAverager(TransformerMixin, BaseEstimator):
             verbose=self.verbose >= 2,
             n_components=self.n_components,
             hidden_size=self.hidden_size,
+            warp_knots=self.warp_knots,
             tangent_refinements=self.tangent_refinements,
             mean_iterations=self.mean_iterations,
         )

@@ -21,8 +21,8 @@ class RTWNearestCentroid(ClassifierMixin, RTWAverager):
     Parameters
     ----------
     manifold, output_length, n_epochs, learning_rate, sinc_window, loss_window, \
-loss_step, penalty, n_components, hidden_size, tangent_refinements, mean_iterations, \
-dtw_window, n_jobs, random_state, device, verbose
+loss_step, penalty, n_components, hidden_size, warp_knots, tangent_refinements, \
+mean_iterations, dtw_window, n_jobs, random_state, device, verbose
         As in :class:`RTWAverager`.
 
     Attributes

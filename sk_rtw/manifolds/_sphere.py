@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 import torch
 
-from .._backend import safe_norm
+from .._backend import inner, safe_norm
 from ._base import SEGMENT_SIGN_INVARIANT_SPHERE, SEGMENT_SPHERE, Manifold
 from ._euclidean import _check_dim
 
@@ -18,7 +18,7 @@ _TAYLOR_SQ = 1e-12
 
 
 def _sphere_exp(p: torch.Tensor, v: torch.Tensor) -> torch.Tensor:
-    sq = (v * v).sum(-1, keepdim=True)
+    sq = inner(v, v, keepdim=True)
     small = sq < _TAYLOR_SQ
     safe_sq = torch.where(small, torch.ones_like(sq), sq)
     n = torch.sqrt(safe_sq)
@@ -28,9 +28,9 @@ def _sphere_exp(p: torch.Tensor, v: torch.Tensor) -> torch.Tensor:
 
 
 def _sphere_log(p: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
-    c = (p * x).sum(-1, keepdim=True)
+    c = inner(p, x, keepdim=True)
     u = x - c * p
-    sq = (u * u).sum(-1, keepdim=True)
+    sq = inner(u, u, keepdim=True)
     # theta / sin(theta) with sin(theta) = |u|, cos(theta) = c; Taylor near theta = 0.
     small = (sq < _TAYLOR_SQ) & (c > 0)
     safe_sq = torch.where(small, torch.ones_like(sq), sq.clamp_min(1e-300))
@@ -40,7 +40,7 @@ def _sphere_log(p: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
 
 
 def _sphere_dist(p: torch.Tensor, x: torch.Tensor, sign_invariant: bool = False) -> torch.Tensor:
-    c = (p * x).sum(-1)
+    c = inner(p, x)
     u = x - c.unsqueeze(-1) * p
     if sign_invariant:
         c = c.abs()
@@ -147,7 +147,7 @@ class Quaternion(Sphere):
         return series
 
     def _log(self, p, x):
-        sign = torch.where((p * x).sum(-1, keepdim=True) < 0, -1.0, 1.0)
+        sign = torch.where(inner(p, x, keepdim=True) < 0, -1.0, 1.0)
         return _sphere_log(p, sign * x)
 
     def _dist(self, p, x):
