@@ -5,6 +5,7 @@ Usage::
     python benchmarks/align_speed.py                  # everything, about 10 min on 2 cores
     python benchmarks/align_speed.py --skip-large     # without the 2,000-series class
     python benchmarks/align_speed.py --device cuda    # on a GPU (adds N = 2000 per epoch)
+    python benchmarks/align_speed.py --device cuda --cuda-graph   # epochs as CUDA graphs
 
 Prints
 1. one full fit (256 epochs, product defaults) of RTW, TTW and NTW on N = 30 Euclidean
@@ -63,9 +64,13 @@ def timed(fn, repeats: int) -> float:
     return statistics.median(times)
 
 
+#: Extra engine options (``--cuda-graph``).
+OPTIONS: dict = {}
+
+
 def fit(X, manifold, method, epochs, device):
     return align(X, manifold=manifold, method=method, n_epochs=epochs, random_state=0,
-                 device=device)  # fmt: skip
+                 device=device, **OPTIONS)  # fmt: skip
 
 
 def dba_seconds(X: np.ndarray, repeats: int) -> float:
@@ -160,9 +165,14 @@ def main(argv=None) -> None:
     parser.add_argument("--threads", type=int, default=2, help="torch threads (default 2)")
     parser.add_argument("--repeats", type=int, default=3, help="timed runs per number")
     parser.add_argument("--skip-large", action="store_true", help="skip the 2,000-series class")
+    parser.add_argument(
+        "--cuda-graph", action="store_true", help="capture epochs in CUDA graphs (GPU only)"
+    )
     args = parser.parse_args(argv)
+    if args.cuda_graph:
+        OPTIONS["cuda_graph"] = True
     torch.set_num_threads(args.threads)
-    print(f"machine: {machine(args.device)}")
+    print(f"machine: {machine(args.device)}" + (", CUDA graphs" if args.cuda_graph else ""))
     section_fits(args.device, args.repeats)
     sizes = (4, 30, 120, 2000) if args.device.startswith("cuda") else (4, 30, 120)
     section_epochs(args.device, args.repeats, sizes)

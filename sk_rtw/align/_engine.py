@@ -86,6 +86,7 @@ class AlignmentConfig:
     tangent_refinements: int
     mean_iterations: int
     device: str
+    cuda_graph: bool = False
 
     def to_dict(self) -> dict[str, Any]:
         """The configuration as a plain dictionary (field name to value).
@@ -199,6 +200,9 @@ def resolve_config(
         "tangent_refinements", options.pop("tangent_refinements", DEFAULT_REFINEMENTS), 0
     )
     mean_iterations = _check_int("mean_iterations", options.pop("mean_iterations", 5), 1)
+    cuda_graph = options.pop("cuda_graph", False)
+    if not isinstance(cuda_graph, bool):
+        raise ValueError(f"cuda_graph must be True or False, got {cuda_graph!r}")
     init = options.pop("init", defaults["init"])
     if init not in ("xavier", "zeros"):
         raise ValueError(f"init must be 'xavier' or 'zeros', got {init!r}")
@@ -235,6 +239,7 @@ def resolve_config(
         tangent_refinements=refinements,
         mean_iterations=mean_iterations,
         device=str(torch.device(device)),
+        cuda_graph=cuda_graph,
     )
 
 
@@ -346,7 +351,8 @@ def align(
         does), ``tangent_refinements`` (Gauss–Newton refinements of the sinc tangent
         point, 0: the centre sample of the window, whose tangent vectors are then computed
         once per fit), ``mean_iterations`` (Gauss–Newton iterations of the mean per epoch,
-        5), ``init`` (``"xavier"`` or ``"zeros"``).
+        5), ``init`` (``"xavier"`` or ``"zeros"``), ``cuda_graph`` (capture each epoch
+        in a CUDA graph on a CUDA device; off by default, see the GPU guide).
 
     Returns
     -------
@@ -415,6 +421,7 @@ def _optimise(
         [p for p in model.parameters() if p.requires_grad],
         config.n_epochs,
         config.learning_rate,
+        cuda_graph=config.cuda_graph,
     )
     report, every = progress_printer(config.method, config.n_epochs, verbose)
     best_epoch = trainer.run(report, every)

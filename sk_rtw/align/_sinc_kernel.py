@@ -17,6 +17,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from .._numba import numba_threads
+
 
 def _window_sums(values, rows, base, frac, lengths, window, u, du):  # pragma: no cover
     n_series, n_points = frac.shape
@@ -72,5 +74,8 @@ PARALLEL_TAPS = 2_000_000
 def window_sums(values, rows, base, frac, lengths, window, u, du) -> None:
     """Fill ``u`` and ``du`` (N, Z, D); see the module docstring for the layouts."""
     n_taps = frac.size * (values.shape[2] if window < 0 else 2 * window + 1)
-    kernel = window_sums_parallel if n_taps >= PARALLEL_TAPS else window_sums_serial
-    kernel(values, rows, base, frac, lengths, window, u, du)
+    if n_taps < PARALLEL_TAPS:
+        window_sums_serial(values, rows, base, frac, lengths, window, u, du)
+        return
+    with numba_threads(-1):
+        window_sums_parallel(values, rows, base, frac, lengths, window, u, du)

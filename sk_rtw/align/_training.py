@@ -7,12 +7,14 @@ bookkeeping uses ``torch.where`` rather than Python decisions on the loss value,
 epoch needs no host-device synchronisation. On a CPU reading the loss is free, and the
 parameters are copied only when the loss improves.
 
-On a CUDA device that lets the whole epoch be captured once in a CUDA graph and replayed
-(``torch.cuda.CUDAGraph``): a small alignment problem is otherwise bound by the launch cost
-of several hundred small kernels per epoch. Capture is tried after a few eager warm-up
-epochs; if an operation cannot be captured (some devices' eigensolvers synchronise), the
-remaining epochs run eagerly with a warning. Losses are read back every ``report_every``
-epochs (progress, non-finite check), not every epoch.
+With ``cuda_graph=True`` on a CUDA device the whole epoch is captured once in a CUDA
+graph and replayed (``torch.cuda.CUDAGraph``): a small alignment problem is otherwise bound
+by the launch cost of several hundred small kernels per epoch. Capture is tried after a
+few eager warm-up epochs; if an operation cannot be captured (some devices' eigensolvers
+synchronise), the remaining epochs run eagerly with a warning. On CUDA, losses are read
+back every ``report_every`` epochs (progress, non-finite check), not every epoch.
+Graph capture is opt-in: it has not yet been checked on a GPU
+(``benchmarks/check_cuda.py`` does that check).
 """
 
 from __future__ import annotations
@@ -40,6 +42,8 @@ class Trainer:
         Trainable parameters (updated in place).
     n_epochs : int
     learning_rate : float
+    cuda_graph : bool, default=False
+        Capture the epoch in a CUDA graph and replay it (CUDA devices only).
     """
 
     def __init__(
@@ -48,8 +52,10 @@ class Trainer:
         parameters: list[torch.Tensor],
         n_epochs: int,
         learning_rate: float,
+        cuda_graph: bool = False,
     ):
         self.loss_fn = loss_fn
+        self.cuda_graph = cuda_graph
         self.parameters = parameters
         self.n_epochs = n_epochs
         device = parameters[0].device
@@ -100,7 +106,7 @@ class Trainer:
             As soon as a report finds a non-finite loss.
         """
         done, graph = 0, None
-        if self.cuda:
+        if self.cuda and self.cuda_graph:
             done = self._warm_up(report, report_every)
             graph = self._capture() if done < self.n_epochs else None
         # on a CPU reading the loss costs nothing: check every epoch

@@ -8,13 +8,11 @@ normalisation unless ``normalize="path"`` asks for the mean cost per path step.
 
 from __future__ import annotations
 
-import contextlib
-import os
 from typing import Any
 
-import numba
 import numpy as np
 
+from .._numba import numba_threads
 from ..manifolds import Manifold
 from ..utils import SeriesCollection, check_series, check_series_collection
 from . import _kernels
@@ -188,23 +186,6 @@ def dtw_path(
     return path, float(D[-1, -1])
 
 
-@contextlib.contextmanager
-def _numba_threads(n_jobs: int | None):
-    if n_jobs is None or n_jobs == 1:
-        n_threads = 1
-    elif n_jobs < 0:
-        n_threads = max(1, (os.cpu_count() or 1) + 1 + n_jobs)
-    else:
-        n_threads = n_jobs
-    n_threads = min(n_threads, numba.config.NUMBA_NUM_THREADS)
-    previous = numba.get_num_threads()
-    numba.set_num_threads(n_threads)
-    try:
-        yield
-    finally:
-        numba.set_num_threads(previous)
-
-
 def dtw_pairwise_distance(
     X: Any,
     Y: Any = None,
@@ -247,7 +228,7 @@ def dtw_pairwise_distance(
             if isinstance(Y, SeriesCollection)
             else check_series_collection(Y, cx.manifold, name="Y", min_length=1)
         )
-    with _numba_threads(n_jobs):
+    with numba_threads(n_jobs):
         return _pairwise(cx, cy, w, squared, symmetric, normalize == "path")
 
 

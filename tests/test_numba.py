@@ -1,0 +1,81 @@
+"""numba's threading layer and the lock around this package's parallel launches."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+from sk_rtw._numba import n_threads
+
+
+def run_python(code: str, **env) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-c", textwrap.dedent(code)],
+        capture_output=True,
+        text=True,
+        env={**os.environ, **env},
+        timeout=300,
+    )
+
+
+def test_workqueue_layer_is_selected_and_concurrent_launches_do_not_abort():
+    """Four threads computing DTW (and the parallel sinc kernel) at the same time: the
+    workqueue layer would abort the process without the lock."""
+    result = run_python(
+        """
+        import threading, numba, numpy as np
+        from sk_rtw import dtw_pairwise_distance
+        from sk_rtw.align._sinc_kernel import window_sums
+        X = np.random.default_rng(0).standard_normal((40, 60))
+        expected = dtw_pairwise_distance(X, n_jobs=2)
+        errors = []
+        def work():
+            try:
+                for _ in range(3):
+                    assert np.array_equal(dtw_pairwise_distance(X, n_jobs=2), expected)
+                    values = np.ones((400, 60, 21, 1))
+                    base = np.zeros((400, 300), dtype=np.int64) + 30
+                    frac = np.full((400, 300), 0.25)
+                    u, du = np.empty((400, 300, 1)), np.empty((400, 300, 1))
+                    window_sums(values, base, base, frac, np.full(400, 60), 10, u, du)
+                    assert np.allclose(u, 1.0)
+            except Exception as exc:
+                errors.append(exc)
+        threads = [threading.Thread(target=work) for _ in range(4)]
+        [t.start() for t in threads]
+        [t.join() for t in threads]
+        assert not errors, errors
+        print(numba.threading_layer())
+        """
+    )
+    assert result.returncode == 0, result.stderr[-2000:]
+    assert result.stdout.strip().splitlines()[-1] == "workqueue"
+
+
+def test_a_layer_chosen_by_the_user_is_kept():
+    result = run_python(
+        """
+        import numba, numpy as np
+        from sk_rtw import dtw_pairwise_distance
+        dtw_pairwise_distance(np.zeros((3, 5)), n_jobs=2)
+        print(numba.threading_layer())
+        """,
+        NUMBA_THREADING_LAYER="omp",
+    )
+    assert result.returncode == 0, result.stderr[-2000:]
+    assert result.stdout.strip().splitlines()[-1] == "omp"
+
+
+@pytest.mark.parametrize(("n_jobs", "expected"), [(None, 1), (1, 1), (2, 2), (-1, None)])
+def test_n_jobs_convention(n_jobs, expected):
+    import numba
+
+    count = n_threads(n_jobs)
+    if expected is None:
+        assert count == min(os.cpu_count() or 1, numba.config.NUMBA_NUM_THREADS)
+    else:
+        assert count == min(expected, numba.config.NUMBA_NUM_THREADS)
