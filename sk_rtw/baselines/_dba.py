@@ -7,11 +7,11 @@ from typing import Any
 
 import numpy as np
 
-from ..dtw import dtw_pairwise_distance
 from ..dtw._dtw import _check_window
+from ..dtw._paths import medoid_index, path_indices
 from ..manifolds import Manifold
 from ..utils import check_series_collection
-from ._result import MultipleAlignment, dtw_path_array, grouped_mean, make_result
+from ._result import MultipleAlignment, grouped_mean, make_result
 
 #: Gauss–Newton steps of each per-sample Fréchet mean in one DBA iteration.
 MEAN_STEPS = 8
@@ -21,8 +21,7 @@ def _initial_mean(collection, init, window, squared) -> np.ndarray:
     if isinstance(init, str):
         if init != "medoid":
             raise ValueError(f"init must be 'medoid' or a series, got {init!r}")
-        D = dtw_pairwise_distance(collection, window=window, squared=squared)
-        return collection.series(int(np.argmin(D.sum(1))))
+        return collection.series(medoid_index(collection, window=window, squared=squared))
     start = check_series_collection([init], collection.manifold, name="init", min_length=1)
     return start.series(0)
 
@@ -82,7 +81,7 @@ def dba_average(
     best = None
     previous = np.inf
     for iteration in range(n_iter + 1):
-        paths, costs = zip(*(dtw_path_array(mean, s, M, w, squared) for s in series), strict=True)
+        paths, costs = zip(*(path_indices(mean, s, M, w, squared) for s in series), strict=True)
         cost = float(sum(costs))
         if best is None or cost < best[0]:
             best = (cost, mean, paths)

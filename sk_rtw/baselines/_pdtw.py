@@ -7,9 +7,10 @@ from typing import Any
 import numpy as np
 
 from ..dtw._dtw import _check_window
+from ..dtw._paths import path_indices
 from ..manifolds import Manifold
 from ..utils import check_series_collection
-from ._result import MultipleAlignment, dtw_path_array, make_result
+from ._result import MultipleAlignment, make_result
 
 
 def pdtw_average(
@@ -65,7 +66,7 @@ def pdtw_average(
     indices = [pick]
     total = 0.0
     for n, x in enumerate(series[1:], start=1):
-        path, cost = dtw_path_array(mean, x, M, w, squared)
+        path, cost = path_indices(mean, x, M, w, squared)
         total += cost
         a, b = mean[path[:, 0]], x[path[:, 1]]
         merged = M.exp(a, M.log(a, b) / (n + 1))

@@ -7,10 +7,11 @@ from typing import Any
 import numpy as np
 
 from ..dtw._dtw import _check_window, point_cost_matrix
+from ..dtw._paths import optimal_path
 from ..manifolds import Quaternion
 from ..utils import check_series, check_series_collection
 from ._mmddtw import nd_dtw
-from ._result import MultipleAlignment, make_result, path_from_costs
+from ._result import MultipleAlignment, make_result
 
 COSTS = ("geodesic", "dot")
 
@@ -69,7 +70,7 @@ def qdtw(
     """
     x, _ = check_series(x, Quaternion(), name="x", min_length=1)
     y, _ = check_series(y, Quaternion(), name="y", min_length=1)
-    return path_from_costs(quaternion_cost_matrix(x, y, cost), _check_window(window))
+    return optimal_path(quaternion_cost_matrix(x, y, cost), _check_window(window))
 
 
 def qdtw_align(

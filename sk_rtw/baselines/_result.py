@@ -6,8 +6,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..dtw import _kernels
-from ..dtw._dtw import point_cost_matrix
 from ..manifolds import Manifold
 
 
@@ -55,21 +53,6 @@ def make_result(
         cost=float(cost),
         manifold=manifold,
     )
-
-
-def path_from_costs(cost: np.ndarray, window: float) -> tuple[np.ndarray, float]:
-    """Optimal DTW path ``(L, 2)`` through a point-cost matrix ``(T_x, T_y)``, and its cost."""
-    D = _kernels.accumulated_cost(cost, window)
-    if not np.isfinite(D[-1, -1]):
-        raise ValueError("the Sakoe–Chiba window is too narrow to connect the series ends")
-    return np.asarray(_kernels.backtrack(D), dtype=np.int64).reshape(-1, 2), float(D[-1, -1])
-
-
-def dtw_path_array(
-    x: np.ndarray, y: np.ndarray, manifold: Manifold, window: float, squared: bool
-) -> tuple[np.ndarray, float]:
-    """Optimal DTW path ``(L, 2)`` between two validated series, and its cost."""
-    return path_from_costs(point_cost_matrix(x, y, manifold, squared), window)
 
 
 def grouped_mean(

@@ -61,6 +61,23 @@ class SeriesCollection:
         """
         return self.data[i, : self.lengths[i]]
 
+    def subset(self, index: Any) -> SeriesCollection:
+        """The series ``index`` (int array or mask), padding cut to their longest.
+
+        Parameters
+        ----------
+        index : array-like of int or bool
+
+        Returns
+        -------
+        SeriesCollection
+        """
+        index = np.flatnonzero(index) if np.asarray(index).dtype == bool else np.asarray(index)
+        lengths = self.lengths[index]
+        return SeriesCollection(
+            data=self.data[index, : int(lengths.max())], lengths=lengths, manifold=self.manifold
+        )
+
 
 def _expected_layout(n_lead: int, point_shape: tuple[int, ...]) -> str:
     lead = "(n_series, n_timepoints" if n_lead == 2 else "(n_timepoints"
@@ -163,6 +180,15 @@ def check_series_collection(
     TypeError
         For non-numeric input.
     """
+    if isinstance(X, SeriesCollection):  # already validated
+        if isinstance(manifold, Manifold) and manifold != X.manifold:
+            raise ValueError(f"{name} holds points of {X.manifold!r}, not of {manifold!r}")
+        if X.n_series < min_series or int(X.lengths.min()) < min_length:
+            raise ValueError(
+                f"{name} needs at least {min_series} series of at least {min_length} time "
+                "points"
+            )
+        return X
     if isinstance(X, (list, tuple)) and (len(X) == 0 or not _is_rectangular(X)):
         if len(X) == 0:
             raise ValueError(f"{name} is empty: at least {min_series} series are needed")

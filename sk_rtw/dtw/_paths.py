@@ -1,0 +1,91 @@
+"""DTW paths as index arrays, and the DTW medoid of a collection.
+
+Helpers shared by the DTW-family baselines and the engine's DTW start: they take series
+that are already validated (``(T, *point_shape)`` arrays on one manifold).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..manifolds import Manifold
+from ..utils import SeriesCollection
+from . import _kernels
+from ._dtw import dtw_pairwise_distance, point_cost_matrix
+
+
+def optimal_path(cost: np.ndarray, window: float = -1.0) -> tuple[np.ndarray, float]:
+    """Optimal DTW path through a point-cost matrix, and its accumulated cost.
+
+    Parameters
+    ----------
+    cost : ndarray of shape (T_x, T_y)
+        Point costs.
+    window : float, default=-1
+        Sakoe–Chiba radius as a fraction of the shorter series; negative: no band.
+
+    Returns
+    -------
+    path : ndarray of shape (P, 2), int
+        Index pairs ``(i, j)`` from ``(0, 0)`` to ``(T_x - 1, T_y - 1)``.
+    cost : float
+    """
+    D = _kernels.accumulated_cost(cost, window)
+    if not np.isfinite(D[-1, -1]):
+        raise ValueError("the Sakoe–Chiba window is too narrow to connect the series ends")
+    return np.asarray(_kernels.backtrack(D), dtype=np.int64).reshape(-1, 2), float(D[-1, -1])
+
+
+def path_indices(
+    x: np.ndarray,
+    y: np.ndarray,
+    manifold: Manifold,
+    window: float = -1.0,
+    squared: bool = False,
+) -> tuple[np.ndarray, float]:
+    """Optimal DTW path ``(P, 2)`` between two validated series, and its cost.
+
+    Parameters
+    ----------
+    x : ndarray of shape (T_x, *point_shape)
+    y : ndarray of shape (T_y, *point_shape)
+    manifold : Manifold
+    window : float, default=-1
+        Sakoe–Chiba radius (fraction of the shorter series); negative: no band.
+    squared : bool, default=False
+        Squared geodesic point costs.
+
+    Returns
+    -------
+    path : ndarray of shape (P, 2), int
+    cost : float
+    """
+    return optimal_path(point_cost_matrix(x, y, manifold, squared), window)
+
+
+def medoid_index(
+    collection: SeriesCollection,
+    candidates: np.ndarray | None = None,
+    window: float | None = None,
+    squared: bool = True,
+) -> int:
+    """Index of the series with the smallest summed DTW cost to the others.
+
+    Parameters
+    ----------
+    collection : SeriesCollection
+    candidates : ndarray of int, optional
+        Only these series take part (both as candidates and as the others); default all.
+    window : float in [0, 1], optional
+        Sakoe–Chiba band.
+    squared : bool, default=True
+        Squared geodesic point costs.
+
+    Returns
+    -------
+    index : int
+        Index into ``collection``.
+    """
+    index = np.arange(collection.n_series) if candidates is None else np.asarray(candidates)
+    D = dtw_pairwise_distance(collection.subset(index), window=window, squared=squared)
+    return int(index[np.argmin(D.sum(1))])
