@@ -376,8 +376,10 @@ def test_single_signal_is_returned_unchanged():
 def test_two_signals_unequal_lengths_and_univariate_input(rng):
     t = np.linspace(0, 1, 60)
     X = [np.sin(2 * np.pi * t**1.3), np.sin(2 * np.pi * np.linspace(0, 1, 45) ** 0.8)]
-    result = align(X, n_epochs=40, random_state=0)
-    assert result.mean.shape == (120, 1) and result.aligned.shape == (2, 120, 1)
+    result = align(X, n_epochs=40, random_state=0)  # Z = T_max
+    assert result.mean.shape == (60, 1) and result.aligned.shape == (2, 60, 1)
+    paper = align(X, n_epochs=2, preset="paper")  # Z = N T_max
+    assert paper.mean.shape == (120, 1)
     result = align(
         np.stack([np.sin(2 * np.pi * t), np.sin(2 * np.pi * t**1.2)]),
         n_epochs=5,
@@ -449,7 +451,7 @@ def test_trainer_keeps_the_lowest_loss_parameters():
     best = trainer.run(lambda done, history: None, 10)
     history = trainer.history.numpy()
     assert best == int(np.argmin(history))
-    assert abs(float(weight) - 1.0) == pytest.approx(history[best])
+    assert abs(float(weight.detach()) - 1.0) == pytest.approx(history[best])
 
 
 def test_verbose_reports_progress(capsys):
@@ -475,3 +477,108 @@ def test_quaternion_mean_and_aligned_series_have_no_sign_flips():
     result = align(flipped, manifold="quaternion", n_epochs=2, random_state=0)
     assert np.all((result.mean[1:] * result.mean[:-1]).sum(-1) > 0)
     assert np.all((result.aligned[:, 1:] * result.aligned[:, :-1]).sum(-1) > 0)
+
+
+# ----------------------------------------------------- starts and presets
+def test_path_warp_is_the_mean_matched_position():
+    from sk_rtw.align._start import path_warp
+
+    path = np.array([[0, 0], [1, 1], [1, 2], [1, 3], [2, 4], [3, 4], [4, 5]])
+    expected = np.array([0.0, 2.0, 4.0, 4.0, 5.0]) / 5
+    np.testing.assert_allclose(path_warp(path, 5, 6), expected)
+
+
+def test_centred_warps_average_to_the_identity(rng):
+    from sk_rtw.align._start import centred_warps
+
+    raw = np.sort(rng.uniform(0, 1, (5, 40)), axis=1)
+    raw[:, 0], raw[:, -1] = 0.0, 1.0
+    warps = centred_warps(raw, 73)
+    np.testing.assert_allclose(warps.mean(0), np.linspace(0, 1, 73), atol=1e-6)
+    assert np.all(np.diff(warps, axis=1) >= -1e-12)
+    # the same common time change for every series: pairwise relations are kept
+    grid = np.linspace(0, 1, 40)
+    times = np.interp(warps[0], raw[0], grid)  # reference time of every output time
+    np.testing.assert_allclose(warps[1], np.interp(times, grid, raw[1]), atol=1e-6)
+
+
+def test_compose_warps_equals_numpy_interp(rng):
+    from sk_rtw.align._warps import compose_warps
+
+    outer = np.sort(rng.uniform(0, 1, (3, 11)), axis=1)
+    inner = rng.uniform(0, 1, (3, 30))
+    got = compose_warps(torch.as_tensor(outer), torch.as_tensor(inner)).numpy()
+    grid = np.linspace(0, 1, 11)
+    expected = np.stack([np.interp(i, grid, o) for o, i in zip(outer, inner, strict=True)])
+    np.testing.assert_allclose(got, expected, atol=1e-14)
+
+
+@pytest.mark.parametrize("manifold", ["euclidean", "sphere", "quaternion", "spd"])
+def test_dtw_start_aligns_before_any_training(manifold):
+    data = make_warped_signals(manifold, 6, 60, 3, strength=0.9)
+    M = data.manifold
+    start = align(data.signals, manifold=M, warp_start="dtw", n_epochs=0, random_state=0)
+    plain = align(data.signals, manifold=M, warp_start="identity", n_epochs=0, random_state=0)
+    assert start.config.warp_start == "dtw"
+    good = alignment_quality(start.aligned, start.mean, M)
+    bad = alignment_quality(plain.aligned, plain.mean, M)
+    assert good < bad / 3, (good, bad)
+    np.testing.assert_allclose(start.warps.mean(0), np.linspace(0, 1, 60), atol=1e-6)
+
+
+def test_identical_series_get_identity_starting_warps():
+    x = make_warped_signals("sphere", 1, 40, 1).original
+    result = align(np.stack([x, x, x]), manifold="sphere", n_epochs=0, random_state=0)
+    np.testing.assert_allclose(result.warps, np.tile(np.linspace(0, 1, 40), (3, 1)), atol=1e-9)
+    np.testing.assert_allclose(result.mean, x, atol=1e-9)
+
+
+def test_given_starting_warps_are_used_and_checked(rng):
+    data = make_warped_signals("euclidean", 3, 30, 2)
+    warps = np.stack([np.linspace(0, 1, 45) ** p for p in (0.9, 1.0, 1.1)])
+    result = align(data.signals, warp_start=warps, n_epochs=0, random_state=0)
+    assert result.config.warp_start == "given" and result.config.output_length == 45
+    np.testing.assert_allclose(result.warps, warps, atol=1e-12)  # zero-readout: start kept
+    with pytest.raises(ValueError, match="shape"):
+        align(data.signals, warp_start=warps[:2])
+    with pytest.raises(ValueError, match="non-decreasing"):
+        align(data.signals, warp_start=warps[:, ::-1])
+    with pytest.raises(ValueError, match="from 0 to 1"):
+        align(data.signals, warp_start=0.5 * warps)
+    with pytest.raises(ValueError, match="output_length"):
+        align(data.signals, warp_start=warps, output_length=30)
+    with pytest.raises(ValueError, match="warp_start"):
+        align(data.signals, warp_start="medoid")
+
+
+def test_training_from_the_dtw_start_never_ends_above_it():
+    data = make_warped_signals("sphere", 5, 50, 4)
+    result = align(data.signals, manifold="sphere", n_epochs=40, random_state=0)
+    assert result.loss_history[result.best_epoch] <= result.loss_history[0]
+    assert np.all(np.diff(result.warps, axis=1) >= -1e-9)  # composition stays monotone
+
+
+def test_presets():
+    X = make_warped_signals("euclidean", 3, 20, 0).signals
+    default = align(X, n_epochs=1, random_state=0).config
+    paper = align(X, n_epochs=1, random_state=0, preset="paper").config
+    assert (default.output_length, default.warp_knots, default.tangent_refinements) == (20, 64, 0)
+    assert (default.warp_start, default.init) == ("dtw", "zero-readout")
+    assert (paper.output_length, paper.warp_knots, paper.tangent_refinements) == (60, None, 2)
+    assert (paper.warp_start, paper.init) == ("identity", "xavier")
+    for method in ("ttw", "ntw"):  # the baselines keep their published start
+        assert align(X, method=method, n_epochs=1).config.warp_start == "identity"
+    explicit = align(X, preset="paper", n_epochs=1, warp_knots=8, output_length=25).config
+    assert (explicit.warp_knots, explicit.output_length) == (8, 25)
+    with pytest.raises(ValueError, match="preset"):
+        align(X, preset="fast")
+
+
+def test_zero_readout_init_starts_at_the_identity_with_diverse_hidden_units():
+    model = NeuralWarps(4, hidden=16, init="zero-readout")
+    zhat = unit_time(30)
+    np.testing.assert_array_equal(model(zhat).detach().numpy(), zhat.expand(4, -1).numpy())
+    assert model.phi.hidden2.weight.std() > 0
+    weights = torch.randn(4, 30, generator=torch.Generator().manual_seed(0))
+    (model(zhat) * weights).sum().backward()
+    assert model.phi.readout.weight.grad.abs().sum() > 0

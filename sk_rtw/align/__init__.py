@@ -1,21 +1,24 @@
 """The alignment engine: Riemannian Time Warping and its TTW/NTW baselines."""
 
-from ._engine import (
+from ._config import (
     METHOD_DEFAULTS,
     METHODS,
-    Alignment,
+    PRESETS,
     AlignmentConfig,
-    align,
     default_output_length,
+    method_defaults,
 )
+from ._engine import Alignment, align
 from ._sinc import tangent_sinc_interpolate
 
 __all__ = [
     "METHODS",
     "METHOD_DEFAULTS",
+    "PRESETS",
     "Alignment",
     "AlignmentConfig",
     "align",
     "default_output_length",
+    "method_defaults",
     "tangent_sinc_interpolate",
 ]

@@ -2,9 +2,8 @@
 
 from __future__ import annotations
 
-import math
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -13,89 +12,12 @@ import torch
 from .._random import check_generator
 from ..manifolds import Manifold
 from ..utils import SeriesCollection, check_series_collection
+from ._config import AlignmentConfig, resolve_config
 from ._loss import monotonicity_penalty, window_loss, window_weights
 from ._sinc import SincInterpolator
+from ._start import dtw_start
 from ._training import Trainer, progress_printer
-from ._warps import NeuralWarps, SineWarps, unit_time
-
-METHODS = ("rtw", "ttw", "ntw")
-
-#: Engine defaults of each method (paper, section V). ``sinc_window=None`` is the full sinc.
-METHOD_DEFAULTS: dict[str, dict[str, Any]] = {
-    "rtw": {
-        "warp": "neural",
-        "init": "xavier",
-        "sinc_window": 10,
-        "loss_window": 5,
-        "loss_step": 5,
-        "penalty": 100.0,
-    },
-    "ntw": {
-        "warp": "neural",
-        "init": "zeros",
-        "sinc_window": None,
-        "loss_window": 0,
-        "loss_step": 1,
-        "penalty": 100.0,
-    },
-    "ttw": {
-        "warp": "sine",
-        "init": "zeros",
-        "sinc_window": 10,
-        "loss_window": 0,
-        "loss_step": 1,
-        "penalty": 0.0,
-    },
-}
-
-#: Largest default output length, as a multiple of the longest input series.
-DEFAULT_LENGTH_FACTOR = 4
-#: Times at which the warp network is evaluated (None: every output time, as the paper).
-#: Measured on the S^1 benchmark (docs: alignment speed): same barycenter loss and
-#: alignment quality as at every output time, at a fraction of the cost.
-DEFAULT_WARP_KNOTS: int | None = 64
-#: Gauss–Newton refinements of the interpolation tangent point (the paper: "a few").
-#: Without refinement the tangent vectors of every window are computed once per fit;
-#: measured on the real demonstrations, interpolated points move by at most 2e-4 of a
-#: sample spacing.
-DEFAULT_REFINEMENTS = 0
-
-
-@dataclass(frozen=True)
-class AlignmentConfig:
-    """The resolved configuration of one :func:`align` run.
-
-    Every field is the value actually used (method defaults filled in); ``output_length``
-    is ``Z``, the length of ``Alignment.mean`` (shape ``(Z, *point_shape)``) and of every
-    aligned series. See :func:`align` for the meaning of each field.
-    """
-
-    method: str
-    warp: str
-    init: str
-    output_length: int
-    n_epochs: int
-    learning_rate: float
-    sinc_window: int | None
-    loss_window: int
-    loss_step: int
-    penalty: float
-    n_components: int
-    hidden_size: int
-    warp_knots: int | None
-    tangent_refinements: int
-    mean_iterations: int
-    device: str
-    cuda_graph: bool = False
-
-    def to_dict(self) -> dict[str, Any]:
-        """The configuration as a plain dictionary (field name to value).
-
-        Returns
-        -------
-        config : dict
-        """
-        return asdict(self)
+from ._warps import NeuralWarps, SineWarps, compose_warps, unit_time
 
 
 @dataclass(frozen=True, eq=False)
@@ -130,119 +52,6 @@ class Alignment:
     fit_time: float = field(default=0.0)
 
 
-def _check_int(name, value, minimum, allow_none=False):
-    if value is None and allow_none:
-        return None
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:
-        raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
-    return int(value)
-
-
-def _check_positive(name, value, allow_zero=False):
-    if (
-        isinstance(value, bool)
-        or not isinstance(value, (int, float, np.number))
-        or not (math.isfinite(value) and (value > 0 or (allow_zero and value == 0)))
-    ):
-        bound = ">= 0" if allow_zero else "> 0"
-        raise ValueError(f"{name} must be a finite number {bound}, got {value!r}")
-    return float(value)
-
-
-def default_output_length(n_signals: int, max_length: int) -> int:
-    """``Z = min(N, 4) * T_max``: the paper's ``N * T_max``, capped at four times ``T_max``.
-
-    The cap keeps memory and time linear in ``N`` for large classes; see the output-length
-    study in the docs for the measurements behind the factor.
-
-    Parameters
-    ----------
-    n_signals : int
-        Number of series N aligned together.
-    max_length : int
-        Length of the longest series, ``T_max``.
-
-    Returns
-    -------
-    Z : int
-        Length of the mean, shape ``(Z, *point_shape)``, and of every aligned series.
-    """
-    return max(2, min(n_signals, DEFAULT_LENGTH_FACTOR) * max_length)
-
-
-def resolve_config(
-    method: str,
-    n_signals: int,
-    max_length: int,
-    *,
-    output_length,
-    n_epochs,
-    learning_rate,
-    sinc_window,
-    loss_window,
-    loss_step,
-    penalty,
-    device,
-    method_options: dict[str, Any],
-) -> AlignmentConfig:
-    """Merge the method defaults with explicit arguments and check every value."""
-    if not isinstance(method, str) or method.lower() not in METHODS:
-        raise ValueError(f"method must be one of {METHODS}, got {method!r}")
-    method = method.lower()
-    defaults = METHOD_DEFAULTS[method]
-    options = dict(method_options)
-    n_components = _check_int("n_components", options.pop("n_components", 8), 1)
-    hidden_size = _check_int("hidden_size", options.pop("hidden_size", 512), 1)
-    warp_knots = _check_int(
-        "warp_knots", options.pop("warp_knots", DEFAULT_WARP_KNOTS), 2, allow_none=True
-    )
-    refinements = _check_int(
-        "tangent_refinements", options.pop("tangent_refinements", DEFAULT_REFINEMENTS), 0
-    )
-    mean_iterations = _check_int("mean_iterations", options.pop("mean_iterations", 5), 1)
-    cuda_graph = options.pop("cuda_graph", False)
-    if not isinstance(cuda_graph, bool):
-        raise ValueError(f"cuda_graph must be True or False, got {cuda_graph!r}")
-    init = options.pop("init", defaults["init"])
-    if init not in ("xavier", "zeros"):
-        raise ValueError(f"init must be 'xavier' or 'zeros', got {init!r}")
-    if options:
-        raise TypeError(f"unknown option(s) for align(): {sorted(options)}")
-    if sinc_window is None:
-        sinc_window = defaults["sinc_window"]
-    elif sinc_window == "full":
-        sinc_window = None
-    else:
-        sinc_window = _check_int("sinc_window", sinc_window, 0)
-    if output_length is None:
-        output_length = default_output_length(n_signals, max_length)
-    return AlignmentConfig(
-        method=method,
-        warp=defaults["warp"],
-        init=init,
-        output_length=_check_int("output_length", output_length, 2),
-        n_epochs=_check_int("n_epochs", n_epochs, 0),
-        learning_rate=_check_positive("learning_rate", learning_rate),
-        sinc_window=sinc_window,
-        loss_window=_check_int(
-            "loss_window", defaults["loss_window"] if loss_window is None else loss_window, 0
-        ),
-        loss_step=_check_int(
-            "loss_step", defaults["loss_step"] if loss_step is None else loss_step, 1
-        ),
-        penalty=_check_positive(
-            "penalty", defaults["penalty"] if penalty is None else penalty, allow_zero=True
-        ),
-        n_components=n_components,
-        hidden_size=hidden_size,
-        warp_knots=warp_knots,
-        tangent_refinements=refinements,
-        mean_iterations=mean_iterations,
-        device=str(torch.device(device)),
-        cuda_graph=cuda_graph,
-    )
-
-
 def _build_warps(config: AlignmentConfig, n_signals: int) -> torch.nn.Module:
     if config.warp == "sine":
         return SineWarps(n_signals, config.n_components)
@@ -270,10 +79,14 @@ class _Problem:
             config.sinc_window,
             config.tangent_refinements,
         )
+        #: Starting warps (N, Z) that the learned warps are composed with, or None.
+        self.start: torch.Tensor | None = None
 
     def forward(self, model: torch.nn.Module):
         raw = model(self.zhat)
         warps = model.finalise(raw)
+        if self.start is not None:
+            warps = compose_warps(self.start, warps)
         aligned = self.interpolate(warps)
         mean = self.manifold.mean(aligned, axis=0, max_iter=self.mean_iterations, tol=0.0)
         distances = self.manifold._dist(aligned, mean.unsqueeze(0))
@@ -288,6 +101,7 @@ def align(
     *,
     manifold: str | Manifold = "euclidean",
     method: str = "rtw",
+    preset: str | None = None,
     output_length: int | None = None,
     n_epochs: int = 256,
     learning_rate: float = 0.01,
@@ -295,6 +109,7 @@ def align(
     loss_window: int | None = None,
     loss_step: int | None = None,
     penalty: float | None = None,
+    warp_start: str | Any = "auto",
     random_state: Any = None,
     device: str | torch.device = "cpu",
     verbose: bool | int = False,
@@ -306,7 +121,8 @@ def align(
     close to their Riemannian mean, by Adam on the paper's loss. ``method`` selects
     Riemannian Time Warping (``"rtw"``) or the Riemannian forms of its baselines
     Trainable Time Warping (``"ttw"``) and Neural Time Warping (``"ntw"``); all three run
-    through the same interpolation, mean, loss and optimisation code.
+    through the same interpolation, mean, loss and optimisation code. ``preset="paper"``
+    gives the paper's exact configuration of each method.
 
     Parameters
     ----------
@@ -318,14 +134,20 @@ def align(
     method : {"rtw", "ttw", "ntw"}, default="rtw"
         Warp model, loss and interpolation defaults:
 
-        - ``"rtw"``: neural warps (Xavier init), windowed sinc, Gaussian window loss,
-          monotonicity penalty;
+        - ``"rtw"``: neural warps, windowed sinc, Gaussian window loss, monotonicity
+          penalty;
         - ``"ntw"``: neural warps (zero init), full sinc, pointwise loss, penalty;
         - ``"ttw"``: sine-series warps with running-maximum monotonicity, windowed sinc,
           pointwise loss.
+    preset : {"default", "paper"} or None, default=None (``"default"``)
+        ``"paper"``: the paper's configuration (``Z = N T_max``, warps starting at the
+        identity, Xavier-initialised network evaluated at every output time, interpolation
+        tangent point refined twice). ``"default"``: ``Z = T_max``, network on 64 knots, no
+        refinement, and for RTW the DTW start (``warp_start="dtw"``) with a zero-readout
+        network. Explicit arguments override the preset.
     output_length : int, optional
-        Length ``Z`` of the aligned series and mean. Default ``min(N, 4) * T_max``
-        (the paper's ``N * T_max``, capped so that memory and time stay linear in ``N``).
+        Length ``Z`` of the aligned series and mean (preset default: ``T_max``, or
+        ``N T_max`` for the paper).
     n_epochs : int, default=256
         Adam iterations; the parameters of the epoch with the lowest loss are kept.
     learning_rate : float, default=0.01
@@ -337,8 +159,16 @@ def align(
         TTW/NTW: 0, the pointwise loss).
     penalty : float, optional
         Weight ``lambda`` of the monotonicity penalty (RTW/NTW: 100; TTW: 0).
+    warp_start : {"identity", "dtw"} or array-like of shape (N, Z), optional
+        What the learned warps start from. ``"identity"``: the paper. ``"dtw"``: warps
+        read off DTW paths to a reference series (the medoid, then the mean, for
+        ``dtw_rounds`` rounds), centred so that their average is the identity; the
+        learned warps are composed with them. An array: your own non-decreasing warps,
+        from 0 to 1, at the ``Z`` output times. Default: the preset's (RTW: ``"dtw"``;
+        TTW, NTW and the paper preset: ``"identity"``).
     random_state : int, RandomState, Generator or None
-        Seeds the network initialisation; equal seeds give identical results.
+        Seeds the network initialisation and the DTW start; equal seeds give identical
+        results.
     device : str or torch.device, default="cpu"
         Torch device for the optimisation, e.g. ``"cuda"``. Results are numpy arrays.
     verbose : bool or int, default=False
@@ -347,12 +177,13 @@ def align(
     **method_options
         ``n_components`` (TTW sine terms, default 8), ``hidden_size`` (512),
         ``warp_knots`` (times at which the warp network is evaluated and linearly
-        interpolated between, 64; None evaluates it at every output time as the paper
+        interpolated between; None evaluates it at every output time as the paper
         does), ``tangent_refinements`` (Gauss–Newton refinements of the sinc tangent
-        point, 0: the centre sample of the window, whose tangent vectors are then computed
-        once per fit), ``mean_iterations`` (Gauss–Newton iterations of the mean per epoch,
-        5), ``init`` (``"xavier"`` or ``"zeros"``), ``cuda_graph`` (capture each epoch
-        in a CUDA graph on a CUDA device; off by default, see the GPU guide).
+        point; 0 uses the centre sample of the window, whose tangent vectors are then
+        computed once per fit), ``mean_iterations`` (Gauss–Newton iterations of the mean
+        per epoch, 5), ``init`` (``"xavier"``, ``"zeros"`` or ``"zero-readout"``),
+        ``dtw_rounds`` (references of the DTW start, 3), ``cuda_graph`` (capture each
+        epoch in a CUDA graph on a CUDA device; off by default, see the GPU guide).
 
     Returns
     -------
@@ -368,14 +199,21 @@ def align(
     >>> X = np.stack([np.sin(2 * np.pi * t ** p) for p in (0.8, 1.0, 1.25)])
     >>> result = align(X, n_epochs=20, random_state=0)
     >>> result.mean.shape, result.aligned.shape, result.warps.shape
-    ((150, 1), (3, 150, 1), (3, 150))
+    ((50, 1), (3, 50, 1), (3, 50))
+    >>> align(X, preset="paper", n_epochs=2).mean.shape  # Z = N T_max
+    (150, 1)
     """
     collection = X if isinstance(X, SeriesCollection) else check_series_collection(X, manifold)
     n_signals = collection.n_series
+    given_start = None
+    if not isinstance(warp_start, str):
+        given_start = _check_warps(warp_start, n_signals, output_length)
+        output_length = given_start.shape[1]
     config = resolve_config(
         method,
         n_signals,
         collection.max_length,
+        preset=preset,
         output_length=output_length,
         n_epochs=n_epochs,
         learning_rate=learning_rate,
@@ -384,14 +222,26 @@ def align(
         loss_step=loss_step,
         penalty=penalty,
         device=device,
+        warp_start="given" if given_start is not None else warp_start,
         method_options=method_options,
     )
     start = time.perf_counter()
-    seed = int(check_generator(random_state).integers(2**31 - 1))
+    rng = check_generator(random_state)
+    seed = int(rng.integers(2**31 - 1))
     with torch.random.fork_rng(devices=[]):
         torch.manual_seed(seed)
         model = _build_warps(config, n_signals).to(config.device)
     problem = _Problem(collection, config)
+    if config.warp_start == "dtw" and n_signals > 1:
+        given_start = dtw_start(
+            collection,
+            config.output_length,
+            config.dtw_rounds,
+            lambda warps: problem.interpolate(warps.to(problem.data.device)),
+            rng,
+        )
+    if given_start is not None:
+        problem.start = torch.as_tensor(given_start, dtype=torch.float64, device=config.device)
     history = np.full(config.n_epochs, np.nan)
     best_epoch = -1
     trainable = [p for p in model.parameters() if p.requires_grad]
@@ -409,6 +259,32 @@ def align(
         config=config,
         fit_time=time.perf_counter() - start,
     )
+
+
+def _check_warps(warps: Any, n_signals: int, output_length: int | None) -> np.ndarray:
+    """Validate starting warps given as an array: (N, Z), non-decreasing, 0 to 1."""
+    try:
+        warps = np.asarray(warps, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise TypeError(
+            "warp_start must be 'identity', 'dtw' or an array of warps of shape (N, Z)"
+        ) from None
+    if warps.ndim != 2 or warps.shape[0] != n_signals or warps.shape[1] < 2:
+        raise ValueError(
+            f"warp_start must have shape (n_series, Z) = ({n_signals}, Z) with Z >= 2, "
+            f"got {warps.shape}"
+        )
+    if output_length is not None and warps.shape[1] != output_length:
+        raise ValueError(
+            f"warp_start has {warps.shape[1]} time points but output_length is {output_length}"
+        )
+    if not np.all(np.isfinite(warps)):
+        raise ValueError("warp_start contains NaN or infinite values")
+    if np.any(np.diff(warps, axis=1) < 0) or np.any(warps < 0) or np.any(warps > 1):
+        raise ValueError("warp_start must be non-decreasing and lie in [0, 1]")
+    if not (np.allclose(warps[:, 0], 0.0) and np.allclose(warps[:, -1], 1.0)):
+        raise ValueError("every warp in warp_start must go from 0 to 1")
+    return warps
 
 
 def _optimise(

@@ -31,6 +31,11 @@ import math
 import torch
 from torch import nn
 
+#: Network initialisations: Xavier everywhere (RTW), zeros everywhere (NTW), or Xavier
+#: hidden layers with a zero readout (the warps start exactly at the identity while the
+#: hidden units differ, so the network is not confined to a linear function as with zeros).
+INITS = ("xavier", "zeros", "zero-readout")
+
 
 def unit_time(n_points: int, dtype=torch.float64, device=None) -> torch.Tensor:
     """``zhat`` = ``(z - 1) / (Z - 1)`` for ``z = 1..Z``, shape (Z,)."""
@@ -73,13 +78,13 @@ class SkipMLP(nn.Module):
         self.hidden1 = nn.Linear(1, hidden, dtype=dtype)
         self.hidden2 = nn.Linear(hidden, hidden, dtype=dtype)
         self.readout = nn.Linear(2 * hidden + 1, n_outputs, dtype=dtype)
+        if init not in INITS:
+            raise ValueError(f"init must be one of {INITS}, got {init!r}")
         for layer in (self.hidden1, self.hidden2, self.readout):
-            if init == "xavier":
-                nn.init.xavier_uniform_(layer.weight)
-            elif init == "zeros":
+            if init == "zeros" or (init == "zero-readout" and layer is self.readout):
                 nn.init.zeros_(layer.weight)
             else:
-                raise ValueError(f"init must be 'xavier' or 'zeros', got {init!r}")
+                nn.init.xavier_uniform_(layer.weight)
             nn.init.zeros_(layer.bias)
 
     def forward(self, zhat: torch.Tensor) -> torch.Tensor:
@@ -87,6 +92,28 @@ class SkipMLP(nn.Module):
         h1 = torch.relu(self.hidden1(x))
         h2 = torch.relu(self.hidden2(h1))
         return self.readout(torch.cat([h2, h1, x], dim=-1))
+
+
+def compose_warps(outer: torch.Tensor, inner: torch.Tensor) -> torch.Tensor:
+    """``outer_n(inner_n(z))`` for warps sampled on a uniform grid of [0, 1].
+
+    ``outer`` is linear between its samples; the result is differentiable in ``inner``.
+
+    Parameters
+    ----------
+    outer : torch.Tensor, shape (N, J)
+        Warps at the times ``j / (J - 1)``, ``J >= 2``.
+    inner : torch.Tensor, shape (N, Z)
+        Times in [0, 1] at which to evaluate each row of ``outer``.
+
+    Returns
+    -------
+    torch.Tensor, shape (N, Z)
+    """
+    position = inner.clamp(0.0, 1.0) * (outer.shape[1] - 1)
+    left = torch.floor(position).detach().long().clamp(0, outer.shape[1] - 2)
+    low, high = torch.gather(outer, 1, left), torch.gather(outer, 1, left + 1)
+    return low + (position - left) * (high - low)
 
 
 def resample_linear(values: torch.Tensor, times: torch.Tensor) -> torch.Tensor:

@@ -1,0 +1,282 @@
+"""Configuration of one alignment: method defaults, presets, checked values.
+
+Two presets:
+
+* ``"paper"``: the paper's configuration of each method (section V): output length
+  ``Z = N T_max``, the warp network evaluated at every output time, the interpolation
+  tangent point refined twice, warps starting at the identity.
+* ``"default"``: the same methods with the settings that measured better or cheaper
+  (docs: alignment speed, class means): ``Z = T_max`` (nearest-centroid accuracy drops
+  when the mean is longer than the series it is compared with), the warp network on 64
+  knots, no tangent-point refinement, and for RTW warps that start from DTW paths to a
+  reference series (see :mod:`sk_rtw.align._start`). TTW and NTW keep the identity start
+  of their published form.
+
+Explicit arguments always override the preset.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+from typing import Any
+
+import numpy as np
+import torch
+
+from ._warps import INITS
+
+METHODS = ("rtw", "ttw", "ntw")
+PRESETS = ("default", "paper")
+WARP_STARTS = ("identity", "dtw")
+
+#: The paper's defaults of each method (section V). ``sinc_window=None`` is the full sinc.
+METHOD_DEFAULTS: dict[str, dict[str, Any]] = {
+    "rtw": {
+        "warp": "neural",
+        "init": "xavier",
+        "sinc_window": 10,
+        "loss_window": 5,
+        "loss_step": 5,
+        "penalty": 100.0,
+        "warp_start": "identity",
+    },
+    "ntw": {
+        "warp": "neural",
+        "init": "zeros",
+        "sinc_window": None,
+        "loss_window": 0,
+        "loss_step": 1,
+        "penalty": 100.0,
+        "warp_start": "identity",
+    },
+    "ttw": {
+        "warp": "sine",
+        "init": "zeros",
+        "sinc_window": 10,
+        "loss_window": 0,
+        "loss_step": 1,
+        "penalty": 0.0,
+        "warp_start": "identity",
+    },
+}
+
+#: Settings of each preset shared by all methods.
+PRESET_DEFAULTS: dict[str, dict[str, Any]] = {
+    "default": {"warp_knots": 64, "tangent_refinements": 0},
+    "paper": {"warp_knots": None, "tangent_refinements": 2},
+}
+
+#: What the default preset changes in a method's paper defaults.
+DEFAULT_PRESET_METHODS: dict[str, dict[str, Any]] = {
+    # start from DTW paths; a zero readout makes the learned warp start at the identity,
+    # so the composed warps start exactly at the DTW start
+    "rtw": {"warp_start": "dtw", "init": "zero-readout"},
+}
+
+#: Options of every method and preset.
+COMMON_DEFAULTS: dict[str, Any] = {
+    "n_components": 8,
+    "hidden_size": 512,
+    "mean_iterations": 5,
+    "dtw_rounds": 3,
+    "cuda_graph": False,
+}
+
+
+def method_defaults(method: str, preset: str = "default") -> dict[str, Any]:
+    """Every engine default of ``method`` under ``preset``.
+
+    Parameters
+    ----------
+    method : {"rtw", "ttw", "ntw"}
+    preset : {"default", "paper"}
+
+    Returns
+    -------
+    defaults : dict
+    """
+    method, preset = check_method(method), check_preset(preset)
+    defaults = {**COMMON_DEFAULTS, **METHOD_DEFAULTS[method], **PRESET_DEFAULTS[preset]}
+    if preset == "default":
+        defaults.update(DEFAULT_PRESET_METHODS.get(method, {}))
+    return defaults
+
+
+def default_output_length(n_signals: int, max_length: int, preset: str = "default") -> int:
+    """Length ``Z`` of the mean: ``T_max`` (default) or ``N T_max`` (the paper).
+
+    The paper lets the mean be ``N`` times longer than the series so that warps can
+    repeat samples; measured on the UCR development archive, a nearest-centroid
+    classifier loses accuracy when its means are longer than the series it compares them
+    with (DBA's own means resampled to 2 T and 4 T: 0.783 -> 0.750 -> 0.720 mean
+    accuracy), and cost grows with ``Z``. See the docs on output length.
+
+    Parameters
+    ----------
+    n_signals : int
+        Number of series N aligned together.
+    max_length : int
+        Length of the longest series, ``T_max``.
+    preset : {"default", "paper"}
+
+    Returns
+    -------
+    Z : int
+        Length of the mean, shape ``(Z, *point_shape)``, and of every aligned series.
+    """
+    if check_preset(preset) == "paper":
+        return max(2, n_signals * max_length)
+    return max(2, max_length)
+
+
+@dataclass(frozen=True)
+class AlignmentConfig:
+    """The resolved configuration of one :func:`align` run.
+
+    Every field is the value actually used (preset and method defaults filled in);
+    ``output_length`` is ``Z``, the length of ``Alignment.mean`` (shape
+    ``(Z, *point_shape)``) and of every aligned series; ``warp_start`` is ``"given"``
+    when starting warps were passed as an array. See :func:`align` for each field.
+    """
+
+    method: str
+    preset: str
+    warp: str
+    init: str
+    warp_start: str
+    dtw_rounds: int
+    output_length: int
+    n_epochs: int
+    learning_rate: float
+    sinc_window: int | None
+    loss_window: int
+    loss_step: int
+    penalty: float
+    n_components: int
+    hidden_size: int
+    warp_knots: int | None
+    tangent_refinements: int
+    mean_iterations: int
+    device: str
+    cuda_graph: bool = False
+
+    def to_dict(self) -> dict[str, Any]:
+        """The configuration as a plain dictionary (field name to value).
+
+        Returns
+        -------
+        config : dict
+        """
+        return asdict(self)
+
+
+def check_method(method: Any) -> str:
+    if not isinstance(method, str) or method.lower() not in METHODS:
+        raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+    return method.lower()
+
+
+def check_preset(preset: Any) -> str:
+    if preset is None:
+        return "default"
+    if not isinstance(preset, str) or preset.lower() not in PRESETS:
+        raise ValueError(f"preset must be one of {PRESETS} or None, got {preset!r}")
+    return preset.lower()
+
+
+def check_int(name: str, value: Any, minimum: int, allow_none: bool = False) -> int | None:
+    if value is None and allow_none:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:
+        raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
+    return int(value)
+
+
+def check_positive(name: str, value: Any, allow_zero: bool = False) -> float:
+    if (
+        isinstance(value, bool)
+        or not isinstance(value, (int, float, np.number))
+        or not (math.isfinite(value) and (value > 0 or (allow_zero and value == 0)))
+    ):
+        bound = ">= 0" if allow_zero else "> 0"
+        raise ValueError(f"{name} must be a finite number {bound}, got {value!r}")
+    return float(value)
+
+
+def resolve_config(
+    method: str,
+    n_signals: int,
+    max_length: int,
+    *,
+    preset: str | None = None,
+    output_length=None,
+    n_epochs=256,
+    learning_rate=0.01,
+    sinc_window=None,
+    loss_window=None,
+    loss_step=None,
+    penalty=None,
+    device="cpu",
+    warp_start: str = "auto",
+    method_options: dict[str, Any] | None = None,
+) -> AlignmentConfig:
+    """Merge preset and method defaults with explicit arguments; check every value.
+
+    ``warp_start`` is the name of the start (``"identity"``, ``"dtw"``), ``"given"`` for
+    starting warps passed as an array, or ``"auto"`` for the preset's choice.
+    """
+    method, preset = check_method(method), check_preset(preset)
+    defaults = method_defaults(method, preset)
+    options = dict(method_options or {})
+    unknown = set(options) - set(COMMON_DEFAULTS) - {"init", "warp_knots", "tangent_refinements"}
+    if unknown:
+        raise TypeError(f"unknown option(s) for align(): {sorted(unknown)}")
+    value = {**defaults, **options}
+    init = value["init"]
+    if init not in INITS:
+        raise ValueError(f"init must be one of {INITS}, got {init!r}")
+    if warp_start == "auto":
+        warp_start = defaults["warp_start"]
+    elif warp_start not in (*WARP_STARTS, "given"):
+        raise ValueError(
+            f"warp_start must be one of {WARP_STARTS} or an array of warps, got {warp_start!r}"
+        )
+    if not isinstance(value["cuda_graph"], bool):
+        raise ValueError(f"cuda_graph must be True or False, got {value['cuda_graph']!r}")
+    if sinc_window is None:
+        sinc_window = defaults["sinc_window"]
+    elif sinc_window == "full":
+        sinc_window = None
+    else:
+        sinc_window = check_int("sinc_window", sinc_window, 0)
+    if output_length is None:
+        output_length = default_output_length(n_signals, max_length, preset)
+    return AlignmentConfig(
+        method=method,
+        preset=preset,
+        warp=defaults["warp"],
+        init=init,
+        warp_start=warp_start,
+        dtw_rounds=check_int("dtw_rounds", value["dtw_rounds"], 1),
+        output_length=check_int("output_length", output_length, 2),
+        n_epochs=check_int("n_epochs", n_epochs, 0),
+        learning_rate=check_positive("learning_rate", learning_rate),
+        sinc_window=sinc_window,
+        loss_window=check_int(
+            "loss_window", defaults["loss_window"] if loss_window is None else loss_window, 0
+        ),
+        loss_step=check_int(
+            "loss_step", defaults["loss_step"] if loss_step is None else loss_step, 1
+        ),
+        penalty=check_positive(
+            "penalty", defaults["penalty"] if penalty is None else penalty, allow_zero=True
+        ),
+        n_components=check_int("n_components", value["n_components"], 1),
+        hidden_size=check_int("hidden_size", value["hidden_size"], 1),
+        warp_knots=check_int("warp_knots", value["warp_knots"], 2, allow_none=True),
+        tangent_refinements=check_int("tangent_refinements", value["tangent_refinements"], 0),
+        mean_iterations=check_int("mean_iterations", value["mean_iterations"], 1),
+        device=str(torch.device(device)),
+        cuda_graph=value["cuda_graph"],
+    )
