@@ -35,7 +35,7 @@ ESTIMATORS = [
         TTWNearestCentroid,
         NTWNearestCentroid,
     )
-]
+] + [RTWNearestCentroid(method="dba"), RTWAverager(method="dba")]
 
 # Each expected failure of scikit-learn's generic checks, with the reason.
 _ANY_LENGTH = (
@@ -229,3 +229,66 @@ def test_predict_before_fit():
         RTWNearestCentroid().predict(np.zeros((2, 10)))
     with pytest.raises(NotFittedError):
         RTWAverager().transform(np.zeros((2, 10)))
+
+
+# ----------------------------------------------------------------- methods
+@pytest.mark.parametrize(
+    ("estimator", "method"),
+    [
+        (RTWAverager(), "rtw"),
+        (TTWAverager(), "ttw"),
+        (NTWNearestCentroid(), "ntw"),
+        (TTWNearestCentroid(method="dba"), "dba"),
+        (RTWNearestCentroid(method="NTW"), "ntw"),
+    ],
+)
+def test_method_none_is_the_classes_own_and_any_method_can_be_chosen(estimator, method):
+    X, y = two_shape_classes(n_per_class=3, length=30)
+    estimator.set_params(n_epochs=2, hidden_size=8, random_state=0)
+    fitted = estimator.fit(X, y)
+    assert fitted.method_ == method
+    if method != "dba":
+        assert all(a.config.method == method for a in fitted.alignments_)
+
+
+def test_dba_method_equals_the_baseline_per_class():
+    from sk_rtw.baselines import dba_average
+
+    X, y = two_shape_classes(n_per_class=4, length=30)
+    clf = RTWNearestCentroid(method="dba").fit(X, y)
+    for k, label in enumerate(clf.classes_):
+        expected = dba_average(X[y == label]).mean
+        np.testing.assert_allclose(clf.means_[k], expected, atol=1e-12)
+
+
+def test_dba_on_a_manifold_and_on_unequal_lengths():
+    q = [make_warped_signals(Quaternion(), 4, 30, seed).signals for seed in (1, 2)]
+    X, y = np.concatenate(q), np.repeat([0, 1], 4)
+    clf = RTWNearestCentroid(manifold="quaternion", method="dba").fit(X, y)
+    np.testing.assert_allclose(np.linalg.norm(clf.means_, axis=-1), 1.0, atol=1e-9)
+    assert clf.score(X, y) == 1.0
+    rng = np.random.default_rng(0)
+    series = [np.sin(np.linspace(0, 6, n)) + 0.01 * rng.standard_normal(n) for n in (30, 40)]
+    series += [np.cos(np.linspace(0, 6, n)) for n in (25, 35)]
+    unequal = RTWNearestCentroid(method="dba").fit(series, [0, 0, 1, 1])
+    assert isinstance(unequal.means_, list)  # medoid lengths differ
+    assert unequal.predict(series).tolist() == [0, 0, 1, 1]
+
+
+def test_grid_search_over_methods():
+    X, y = two_shape_classes(n_per_class=4, length=30)
+    search = GridSearchCV(
+        RTWNearestCentroid(n_epochs=3, hidden_size=8, random_state=0),
+        {"method": ["rtw", "dba"], "preset": [None, "paper"]},
+        cv=2,
+    ).fit(X, y)
+    assert search.best_params_["method"] in ("rtw", "dba")
+    assert np.isfinite(search.cv_results_["mean_test_score"]).all()
+
+
+def test_bad_method_and_preset_are_named():
+    X, y = two_shape_classes(n_per_class=2, length=20)
+    with pytest.raises(ValueError, match="method must be one of"):
+        RTWNearestCentroid(method="kmeans").fit(X, y)
+    with pytest.raises(ValueError, match="preset"):
+        RTWNearestCentroid(preset="fast").fit(X, y)

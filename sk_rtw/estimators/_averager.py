@@ -13,45 +13,62 @@ from sklearn.utils import check_random_state, column_or_1d
 from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted
 
-from ..align import Alignment, align, default_output_length
+from ..align import METHODS, align, default_output_length
+from ..align._config import check_preset
+from ..baselines import dba_average
 from ..dtw import dtw_pairwise_distance
 from ..manifolds import Manifold
 from ..utils import SeriesCollection, check_series_collection
+
+#: Averaging methods of the estimators: the engine's and DTW barycenter averaging.
+ESTIMATOR_METHODS = (*METHODS, "dba")
 
 
 class RTWAverager(TransformerMixin, BaseEstimator):
     """Learn one Riemannian Time Warping mean per class; transform to DTW distances.
 
-    ``fit`` aligns the series of each class separately with :func:`sk_rtw.align` and keeps
-    the class means; ``transform`` returns the manifold-DTW distance of each series to
-    each mean (like ``KMeans.transform``).
+    ``fit`` averages the series of each class separately -- with :func:`sk_rtw.align`
+    (RTW, TTW, NTW) or with manifold DTW barycenter averaging (``method="dba"``) -- and
+    keeps the class means; ``transform`` returns the manifold-DTW distance of each series
+    to each mean (like ``KMeans.transform``).
 
     Parameters
     ----------
     manifold : str or Manifold, default="euclidean"
         Space of the samples; a name takes its dimension from the data.
+    method : {"rtw", "ttw", "ntw", "dba"} or None, default=None
+        Averaging method; None is the estimator's own (RTW here; TTW for
+        :class:`TTWAverager`, ...). ``"dba"``: DTW barycenter averaging with Fréchet means
+        (:func:`sk_rtw.baselines.dba_average`, squared costs, medoid start), on any
+        manifold. Searchable with ``GridSearchCV`` like any parameter.
+    preset : {"default", "paper"} or None, default=None
+        Engine preset (see :func:`sk_rtw.align`): ``"paper"`` is the paper's exact
+        configuration (means of length ``N T_max``, warps starting at the identity).
     output_length : int, optional
-        Length ``Z`` of the means. Default: ``min(N_max, 4) * T_max`` with ``N_max`` the
-        largest class (see :func:`sk_rtw.align.default_output_length`).
+        Length ``Z`` of the means. Default: the preset's, with ``N`` the largest class:
+        ``T_max`` (default) or ``N_max T_max`` (paper). Not used by DBA, whose means keep
+        the length of their start (the class medoid).
     n_epochs : int, default=256
         Adam epochs per class.
     learning_rate : float, default=0.01
     sinc_window, loss_window, loss_step, penalty : optional
         Engine settings; None takes the method's default (see :func:`sk_rtw.align`).
+    warp_start : {"auto", "identity", "dtw"}, default="auto"
+        Starting warps (``"auto"``: the preset's; RTW starts from DTW paths by default).
     n_components : int, default=8
         Sine terms of the TTW warps (TTW only).
     hidden_size : int, default=512
         Hidden width of the RTW/NTW warp network.
-    warp_knots : int or None, default=64
-        Times at which the RTW/NTW warp network is evaluated (linear in between); None
-        evaluates it at every output time, as the paper does.
-    tangent_refinements : int, default=0
-        Gauss–Newton refinements of the interpolation tangent point (0: the centre sample
-        of each window; the paper refines it "a few" times).
+    warp_knots : int, None or "auto", default="auto"
+        Times at which the warp network is evaluated (linear in between); None: at every
+        output time (the paper); ``"auto"``: the preset's (64, or None for the paper).
+    tangent_refinements : int or "auto", default="auto"
+        Gauss–Newton refinements of the interpolation tangent point (``"auto"``: the
+        preset's, 0 or 2 for the paper).
     mean_iterations : int, default=5
         Gauss–Newton iterations of the mean per epoch.
     dtw_window : float in [0, 1], optional
-        Sakoe–Chiba band of the DTW used by ``transform``.
+        Sakoe–Chiba band of the DTW used by ``transform`` (and by DBA).
     n_jobs : int, optional
         Classes fitted in parallel (joblib) and threads of the DTW computations.
     random_state : int, RandomState or None
@@ -65,10 +82,14 @@ class RTWAverager(TransformerMixin, BaseEstimator):
     ----------
     classes_ : ndarray of shape (n_classes,)
         Class labels (``[0]`` when fitted without ``y``).
-    means_ : ndarray of shape (n_classes, Z, *point_shape)
-        One mean per class, on the manifold.
-    alignments_ : list of Alignment
-        Per class: aligned series, warps, loss history, configuration.
+    means_ : ndarray of shape (n_classes, Z, *point_shape) or list of ndarray
+        One mean per class, on the manifold; a list when the means differ in length
+        (DBA on series of unequal lengths).
+    alignments_ : list of Alignment or MultipleAlignment
+        Per class: aligned series, warps and, for the engine's methods, loss history and
+        configuration.
+    method_ : str
+        The averaging method used.
     manifold_ : Manifold
         The manifold resolved against the training data.
     n_features_in_ : int
@@ -83,7 +104,9 @@ class RTWAverager(TransformerMixin, BaseEstimator):
     >>> X = np.stack([np.sin(2 * np.pi * t ** p) for p in (0.8, 1.0, 1.2, 0.9)])
     >>> averager = RTWAverager(n_epochs=10, random_state=0).fit(X, [0, 0, 1, 1])
     >>> averager.means_.shape, averager.transform(X).shape
-    ((2, 80, 1), (4, 2))
+    ((2, 40, 1), (4, 2))
+    >>> RTWAverager(method="dba").fit(X, [0, 0, 1, 1]).means_.shape
+    (2, 40, 1)
     """
 
     _method = "rtw"
@@ -91,6 +114,8 @@ class RTWAverager(TransformerMixin, BaseEstimator):
     def __init__(
         self,
         manifold: str | Manifold = "euclidean",
+        method: str | None = None,
+        preset: str | None = None,
         output_length: int | None = None,
         n_epochs: int = 256,
         learning_rate: float = 0.01,
@@ -98,10 +123,11 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         loss_window: int | None = None,
         loss_step: int | None = None,
         penalty: float | None = None,
+        warp_start: str = "auto",
         n_components: int = 8,
         hidden_size: int = 512,
-        warp_knots: int | None = 64,
-        tangent_refinements: int = 0,
+        warp_knots: int | str | None = "auto",
+        tangent_refinements: int | str = "auto",
         mean_iterations: int = 5,
         dtw_window: float | None = None,
         n_jobs: int | None = None,
@@ -110,6 +136,8 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         verbose: int = 0,
     ):
         self.manifold = manifold
+        self.method = method
+        self.preset = preset
         self.output_length = output_length
         self.n_epochs = n_epochs
         self.learning_rate = learning_rate
@@ -117,6 +145,7 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         self.loss_window = loss_window
         self.loss_step = loss_step
         self.penalty = penalty
+        self.warp_start = warp_start
         self.n_components = n_components
         self.hidden_size = hidden_size
         self.warp_knots = warp_knots
@@ -130,7 +159,7 @@ class RTWAverager(TransformerMixin, BaseEstimator):
 
     # ------------------------------------------------------------------ fit
     def fit(self, X: Any, y: Any = None):
-        """Align the series of each class and store the class means.
+        """Average the series of each class and store the class means.
 
         Parameters
         ----------
@@ -146,7 +175,17 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         self._fit_means(X, y, require_two_classes=False)
         return self
 
+    def _resolve_method(self) -> str:
+        method = self._method if self.method is None else self.method
+        if not isinstance(method, str) or method.lower() not in ESTIMATOR_METHODS:
+            raise ValueError(
+                f"method must be one of {ESTIMATOR_METHODS} or None, got {self.method!r}"
+            )
+        return method.lower()
+
     def _fit_means(self, X, y, require_two_classes):
+        method = self._resolve_method()
+        check_preset(self.preset)
         collection = check_series_collection(X, self.manifold)
         if y is None:
             labels = np.zeros(collection.n_series, dtype=int)
@@ -161,11 +200,15 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         sizes = np.bincount(codes)
         output_length = self.output_length
         if output_length is None:
-            output_length = default_output_length(int(sizes.max()), collection.max_length)
+            output_length = default_output_length(
+                int(sizes.max()), collection.max_length, self.preset or "default"
+            )
         seeds = check_random_state(self.random_state).randint(2**31 - 1, size=len(classes))
         members = [np.flatnonzero(codes == k) for k in range(len(classes))]
         jobs = (
-            delayed(self._fit_class)(_subset(collection, idx), output_length, int(seed), label)
+            delayed(self._fit_class)(
+                collection.subset(idx), method, output_length, int(seed), label
+            )
             for idx, seed, label in zip(members, seeds, classes, strict=True)
         )
         if self.n_jobs in (None, 1) or len(classes) == 1:
@@ -173,41 +216,59 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         else:
             alignments = Parallel(n_jobs=self.n_jobs)(jobs)
         self.classes_ = classes
+        self.method_ = method
         self.manifold_ = collection.manifold
         self.alignments_ = alignments
-        self.means_ = np.stack([a.mean for a in alignments])
+        means = [a.mean for a in alignments]
+        same_length = len({len(m) for m in means}) == 1
+        self.means_ = np.stack(means) if same_length else means
         if collection.equal_length and collection.manifold.point_shape == (1,):
             self.n_features_in_ = collection.max_length
         return self
 
+    def _engine_options(self) -> dict[str, Any]:
+        options = {
+            "n_components": self.n_components,
+            "hidden_size": self.hidden_size,
+            "mean_iterations": self.mean_iterations,
+        }
+        if not (isinstance(self.warp_knots, str) and self.warp_knots == "auto"):
+            options["warp_knots"] = self.warp_knots
+        if not (isinstance(self.tangent_refinements, str) and self.tangent_refinements == "auto"):
+            options["tangent_refinements"] = self.tangent_refinements
+        return options
+
     def _fit_class(
-        self, collection: SeriesCollection, output_length: int, seed: int, label
-    ) -> Alignment:
+        self, collection: SeriesCollection, method: str, output_length: int, seed: int, label
+    ):
         start = time.perf_counter()
-        result = align(
-            collection,
-            method=self._method,
-            output_length=output_length,
-            n_epochs=self.n_epochs,
-            learning_rate=self.learning_rate,
-            sinc_window=self.sinc_window,
-            loss_window=self.loss_window,
-            loss_step=self.loss_step,
-            penalty=self.penalty,
-            random_state=seed,
-            device=self.device,
-            verbose=self.verbose >= 2,
-            n_components=self.n_components,
-            hidden_size=self.hidden_size,
-            warp_knots=self.warp_knots,
-            tangent_refinements=self.tangent_refinements,
-            mean_iterations=self.mean_iterations,
-        )
+        if method == "dba":
+            result = dba_average(collection, window=self.dtw_window)
+            detail = f"cost {result.cost:.4g}"
+        else:
+            result = align(
+                collection,
+                method=method,
+                preset=self.preset,
+                output_length=output_length,
+                n_epochs=self.n_epochs,
+                learning_rate=self.learning_rate,
+                sinc_window=self.sinc_window,
+                loss_window=self.loss_window,
+                loss_step=self.loss_step,
+                penalty=self.penalty,
+                warp_start=self.warp_start,
+                random_state=seed,
+                device=self.device,
+                verbose=self.verbose >= 2,
+                **self._engine_options(),
+            )
+            detail = f"best epoch {result.best_epoch + 1}"
         if self.verbose:
             name = label.item() if isinstance(label, np.generic) else label
             print(
                 f"[{type(self).__name__}] class {name!r}: {collection.n_series} series, "
-                f"{time.perf_counter() - start:.1f} s, best epoch {result.best_epoch + 1}",
+                f"{method}, {time.perf_counter() - start:.1f} s, {detail}",
                 file=sys.stderr,
                 flush=True,
             )
@@ -285,12 +346,3 @@ def _encode(labels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         classes[:] = ordered
         lookup = {v: i for i, v in enumerate(ordered)}
         return classes, np.array([lookup[v] for v in labels.tolist()])
-
-
-def _subset(collection: SeriesCollection, index: np.ndarray) -> SeriesCollection:
-    lengths = collection.lengths[index]
-    return SeriesCollection(
-        data=collection.data[index, : int(lengths.max())],
-        lengths=lengths,
-        manifold=collection.manifold,
-    )
