@@ -10,7 +10,15 @@ from scipy.stats import rankdata
 
 from ._protocol import pairwise_tests
 
-PAIRS = (("ttw", "rtw"), ("ntw", "rtw"), ("dba", "rtw"), ("1nn-dtw", "rtw"), ("ttw", "ntw"))
+PAIRS = (
+    ("ttw", "rtw"),
+    ("ntw", "rtw"),
+    ("dba", "rtw"),
+    ("rtw-paper", "rtw"),
+    ("1nn-dtw", "rtw"),
+    ("ttw", "ntw"),
+    ("aeon-dba", "dba"),
+)
 PAPER_TABLE_II = {  # averaging, classification (% of 128 datasets)
     ("ttw", "rtw"): {"a": (7.34, 5.47), "b": (39.84, 54.69), "none": (52.82, 39.84)},
     ("ntw", "rtw"): {"a": (7.81, 6.25), "b": (8.59, 35.16), "none": (83.60, 58.59)},
@@ -60,9 +68,26 @@ def accuracy_matrix(records, methods):
     return names, np.array(rows, dtype=float).reshape(len(rows), len(methods))
 
 
+def wins_ties_losses(records: list[dict], a: str, b: str) -> dict:
+    """Datasets where method ``a`` is more / equally / less accurate than ``b``."""
+    _, acc = accuracy_matrix(records, [a, b])
+    if not len(acc):
+        return {"wins": 0, "ties": 0, "losses": 0, "n": 0, "mean_a": np.nan, "mean_b": np.nan}
+    diff = acc[:, 0] - acc[:, 1]
+    tie = np.abs(diff) <= 1e-12
+    return {
+        "wins": int(((diff > 0) & ~tie).sum()),
+        "ties": int(tie.sum()),
+        "losses": int(((diff < 0) & ~tie).sum()),
+        "n": len(acc),
+        "mean_a": float(acc[:, 0].mean()),
+        "mean_b": float(acc[:, 1].mean()),
+    }
+
+
 def markdown(records: list[dict], methods: list[str], command: str, machine: str) -> str:
     lines = [
-        "# UCR benchmark: RTW vs TTW vs NTW (and DBA, 1-NN DTW references)",
+        "# UCR benchmark: RTW vs TTW vs NTW vs DBA (and aeon's DBA, 1-NN DTW references)",
         "",
         f"Command: `{command}`  ",
         f"Machine: {machine}",
@@ -83,6 +108,24 @@ def markdown(records: list[dict], methods: list[str], command: str, machine: str
         lines += [
             f"| {m} | {acc[:, i].mean():.4f} | {ranks[i]:.2f} |" for i, m in enumerate(methods)
         ]
+        lines.append("")
+    if "rtw" in methods:
+        lines += [
+            "## RTW against each method: datasets where RTW's accuracy is higher / equal / "
+            "lower",
+            "",
+            "| method | RTW wins | ties | RTW losses | n | mean accuracy (RTW vs method) |",
+            "| --- | --- | --- | --- | --- | --- |",
+        ]
+        for other in methods:
+            if other == "rtw":
+                continue
+            row = wins_ties_losses(records, "rtw", other)
+            if row["n"]:
+                lines.append(
+                    f"| {other} | {row['wins']} | {row['ties']} | {row['losses']} | {row['n']} "
+                    f"| {row['mean_a']:.4f} vs {row['mean_b']:.4f} |"
+                )
         lines.append("")
     lines += [
         "## Paired t-tests (alpha = 0.05): share of datasets (Table II layout)",
@@ -142,7 +185,7 @@ def markdown(records: list[dict], methods: list[str], command: str, machine: str
 
 
 def scatter_plot(records: list[dict], path: Path) -> bool:
-    """RTW accuracy (y) against TTW and NTW accuracy (x), one point per dataset."""
+    """RTW accuracy (y) against TTW, NTW and DBA accuracy (x), one point per dataset."""
     try:
         import matplotlib
 
@@ -151,7 +194,7 @@ def scatter_plot(records: list[dict], path: Path) -> bool:
     except ImportError:
         return False
     fig, ax = plt.subplots(figsize=(5, 5))
-    for other, colour in (("ttw", "tab:red"), ("ntw", "gold")):
+    for other, colour in (("ttw", "tab:red"), ("ntw", "gold"), ("dba", "tab:blue")):
         names, acc = accuracy_matrix(records, [other, "rtw"])
         if len(names):
             ax.scatter(
@@ -166,7 +209,7 @@ def scatter_plot(records: list[dict], path: Path) -> bool:
     ax.set(
         xlim=(0, 1.02),
         ylim=(0, 1.02),
-        xlabel="TTW / NTW accuracy",
+        xlabel="TTW / NTW / DBA accuracy",
         ylabel="RTW accuracy",
         title="Nearest-centroid accuracy per UCR dataset",
     )

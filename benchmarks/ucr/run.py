@@ -47,7 +47,12 @@ from benchmarks.ucr._data import (  # noqa: E402
     available_datasets,
     default_data_dir,
 )
-from benchmarks.ucr._protocol import ALL_METHODS, RunConfig, process_dataset  # noqa: E402
+from benchmarks.ucr._protocol import (  # noqa: E402
+    ALL_METHODS,
+    DEFAULT_METHODS,
+    RunConfig,
+    process_dataset,
+)
 from benchmarks.ucr._summary import load_records, markdown, scatter_plot  # noqa: E402
 
 
@@ -69,7 +74,11 @@ def parse_args(argv=None) -> argparse.Namespace:
         "--all", action="store_true", help="every dataset in --data-dir plus aeon's bundled ones"
     )
     parser.add_argument(
-        "--methods", nargs="+", default=list(ALL_METHODS), choices=list(ALL_METHODS)
+        "--methods",
+        nargs="+",
+        default=list(DEFAULT_METHODS),
+        choices=list(ALL_METHODS),
+        help="rows to compute (default: all but rtw-paper, which is slow)",
     )
     parser.add_argument("--epochs", type=int, default=256)
     parser.add_argument(
