@@ -5,6 +5,7 @@ from ._config import (
     METHODS,
     PRESETS,
     AlignmentConfig,
+    classification_output_length,
     default_output_length,
     method_defaults,
 )
@@ -18,6 +19,7 @@ __all__ = [
     "Alignment",
     "AlignmentConfig",
     "align",
+    "classification_output_length",
     "default_output_length",
     "method_defaults",
     "tangent_sinc_interpolate",

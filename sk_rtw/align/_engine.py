@@ -142,12 +142,12 @@ def align(
     preset : {"default", "paper"} or None, default=None (``"default"``)
         ``"paper"``: the paper's configuration (``Z = N T_max``, warps starting at the
         identity, Xavier-initialised network evaluated at every output time, interpolation
-        tangent point refined twice). ``"default"``: ``Z = T_max``, network on 64 knots, no
-        refinement, and for RTW the DTW start (``warp_start="dtw"``) with a zero-readout
-        network. Explicit arguments override the preset.
+        tangent point refined twice). ``"default"``: ``Z = min(N, 4) T_max``, network on 64
+        knots, no refinement, and for RTW the DTW start (``warp_start="dtw"``) with a
+        zero-readout network. Explicit arguments override the preset.
     output_length : int, optional
-        Length ``Z`` of the aligned series and mean (preset default: ``T_max``, or
-        ``N T_max`` for the paper).
+        Length ``Z`` of the aligned series and mean (preset default: ``min(N, 4) T_max``,
+        or ``N T_max`` for the paper).
     n_epochs : int, default=256
         Adam iterations; the parameters of the epoch with the lowest loss are kept.
     learning_rate : float, default=0.01
@@ -199,7 +199,7 @@ def align(
     >>> X = np.stack([np.sin(2 * np.pi * t ** p) for p in (0.8, 1.0, 1.25)])
     >>> result = align(X, n_epochs=20, random_state=0)
     >>> result.mean.shape, result.aligned.shape, result.warps.shape
-    ((50, 1), (3, 50, 1), (3, 50))
+    ((150, 1), (3, 150, 1), (3, 150))
     >>> align(X, preset="paper", n_epochs=2).mean.shape  # Z = N T_max
     (150, 1)
     """

@@ -13,7 +13,7 @@ from sklearn.utils import check_random_state, column_or_1d
 from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted
 
-from ..align import METHODS, align, default_output_length
+from ..align import METHODS, align, classification_output_length
 from ..align._config import check_preset
 from ..baselines import dba_average
 from ..dtw import dtw_pairwise_distance
@@ -45,8 +45,10 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         Engine preset (see :func:`sk_rtw.align`): ``"paper"`` is the paper's exact
         configuration (means of length ``N T_max``, warps starting at the identity).
     output_length : int, optional
-        Length ``Z`` of the means. Default: the preset's, with ``N`` the largest class:
-        ``T_max`` (default) or ``N_max T_max`` (paper). Not used by DBA, whose means keep
+        Length ``Z`` of the means. Default ``T_max``, the length of the longest training
+        series: means longer than the series they are compared with classify worse
+        (:func:`sk_rtw.align.classification_output_length`); the paper preset uses
+        ``N_max T_max`` with ``N_max`` the largest class. Not used by DBA, whose means keep
         the length of their start (the class medoid).
     n_epochs : int, default=256
         Adam epochs per class.
@@ -200,7 +202,7 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         sizes = np.bincount(codes)
         output_length = self.output_length
         if output_length is None:
-            output_length = default_output_length(
+            output_length = classification_output_length(
                 int(sizes.max()), collection.max_length, self.preset or "default"
             )
         seeds = check_random_state(self.random_state).randint(2**31 - 1, size=len(classes))
