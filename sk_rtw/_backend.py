@@ -83,7 +83,9 @@ def inner(a: torch.Tensor, b: torch.Tensor, keepdim: bool = False) -> torch.Tens
 
 
 def safe_norm(v: torch.Tensor, dim: int | tuple[int, ...] = -1) -> torch.Tensor:
-    """Euclidean norm whose gradient at zero is zero instead of NaN."""
+    """Euclidean norm whose gradient at zero is zero instead of NaN (NaN stays NaN)."""
+    if dim == -1 and v.shape[-1] == 1:
+        return v.abs().squeeze(-1)  # exact at any magnitude
     if dim == -1:
         sq = sum_last(v * v)
     elif dim == (-2, -1):
@@ -91,4 +93,5 @@ def safe_norm(v: torch.Tensor, dim: int | tuple[int, ...] = -1) -> torch.Tensor:
     else:
         sq = (v * v).sum(dim=dim)
     positive = sq > 0
-    return torch.where(positive, torch.sqrt(torch.where(positive, sq, torch.ones_like(sq))), 0.0)
+    root = torch.sqrt(torch.where(positive, sq, torch.ones_like(sq)))
+    return torch.where(positive, root, sq * 0.0)  # 0 at 0, NaN for NaN

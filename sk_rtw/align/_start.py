@@ -121,5 +121,5 @@ def dtw_start(
         if round_ < rounds - 1:
             with torch.no_grad():
                 aligned = resample(torch.as_tensor(warps))
-                reference = manifold.mean(aligned.cpu().numpy(), axis=0)
+                reference = manifold.mean(aligned, axis=0, max_iter=8, tol=0.0).cpu().numpy()
     return warps

@@ -93,7 +93,7 @@ def dba_average(
         groups = np.concatenate([p[:, 0] for p in paths])
         points = np.concatenate([s[p[:, 1]] for s, p in zip(series, paths, strict=True)])
         # Gauss–Newton from the previous average: it is close, so a few steps suffice.
-        mean = grouped_mean(M, groups, points, len(mean), start=mean, max_iter=MEAN_STEPS)
+        mean = grouped_mean(M, groups, points, len(mean), start=mean, max_iter=MEAN_STEPS, tol=0.0)
     cost, mean, paths = best
     first = [np.searchsorted(p[:, 0], np.arange(len(mean))) for p in paths]
     indices = np.stack([p[f, 1] for p, f in zip(paths, first, strict=True)])

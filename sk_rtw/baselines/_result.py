@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import torch
 
 from ..manifolds import Manifold
 
@@ -62,6 +63,7 @@ def grouped_mean(
     n_groups: int,
     start: np.ndarray | None = None,
     max_iter: int = 64,
+    tol: float = 1e-10,
 ) -> np.ndarray:
     """Fréchet mean of ``points`` per group label in ``range(n_groups)``, all at once.
 
@@ -83,4 +85,9 @@ def grouped_mean(
     padded[groups, slots + offset] = points
     weights = np.zeros((n_groups, counts.max() + offset))
     weights[groups, slots + offset] = 1.0
-    return manifold.mean(padded, weights.T, axis=1, max_iter=max_iter)
+    # torch in, torch out: the points were validated on the way in; a fixed number of
+    # steps from a close start is what DBA asks for (tol=0: no convergence warning)
+    mean = manifold.mean(
+        torch.as_tensor(padded), torch.as_tensor(weights.T), axis=1, max_iter=max_iter, tol=tol
+    )
+    return mean.numpy()

@@ -167,20 +167,64 @@ def backtrack(D: np.ndarray):
 
 
 @njit(cache=True, inline="always")
+def _accumulate_scaled(value, scale, ssq):
+    """One step of the overflow-free sum of squares ``scale^2 ssq`` (as LAPACK's nrm2)."""
+    magnitude = abs(value)
+    if magnitude > 0.0:
+        if scale < magnitude:
+            ssq = 1.0 + ssq * (scale / magnitude) ** 2
+            scale = magnitude
+        else:
+            ssq += (magnitude / scale) ** 2
+    return scale, ssq
+
+
+@njit(cache=True)
+def _robust_distance(xi, yj, segments):
+    """``sqrt(sum_s d_s^2)`` without overflow or underflow (for extreme magnitudes)."""
+    scale, ssq = 0.0, 1.0
+    for s in range(segments.shape[0]):
+        start, stop, code = segments[s, 0], segments[s, 1], segments[s, 2]
+        if code == SEGMENT_EUCLIDEAN:
+            for k in range(start, stop):
+                scale, ssq = _accumulate_scaled(xi[k] - yj[k], scale, ssq)
+        else:
+            dot = 0.0
+            for k in range(start, stop):
+                dot += xi[k] * yj[k]
+            perp_scale, perp_ssq = 0.0, 1.0
+            for k in range(start, stop):
+                perp_scale, perp_ssq = _accumulate_scaled(
+                    yj[k] - dot * xi[k], perp_scale, perp_ssq
+                )
+            angle = math.atan2(
+                perp_scale * math.sqrt(perp_ssq),
+                abs(dot) if code == SEGMENT_SIGN_INVARIANT_SPHERE else dot,
+            )
+            scale, ssq = _accumulate_scaled(angle, scale, ssq)
+    return scale * math.sqrt(ssq)
+
+
+#: Sums of squares outside [TINY, HUGE] lost precision to underflow or overflow.
+_TINY, _HUGE = 1e-290, 1e290
+
+
+@njit(cache=True, inline="always")
 def _cost_row(x, y, i, ny, segments, squared, row):
     """Row ``i`` of the cost matrix: point costs between ``x[i]`` and ``y[:ny]``."""
     xi = x[i]
     n_segments = segments.shape[0]
+    if n_segments == 1 and segments[0, 2] == SEGMENT_EUCLIDEAN and segments[0, 1] == 1:
+        a = xi[0]  # univariate: |a - b| exactly, at any magnitude
+        for j in range(ny):
+            diff = abs(a - y[j, 0])
+            row[j] = diff * diff if squared else diff
+        return
     for j in range(ny):
         row[j] = 0.0
     for s in range(n_segments):
         start, stop, code = segments[s, 0], segments[s, 1], segments[s, 2]
-        if code == SEGMENT_EUCLIDEAN and stop - start == 1:
-            a = xi[start]
-            for j in range(ny):
-                diff = a - y[j, start]
-                row[j] += diff * diff
-        elif code == SEGMENT_EUCLIDEAN:
+        if code == SEGMENT_EUCLIDEAN:
             for j in range(ny):
                 sq = 0.0
                 for k in range(start, stop):
@@ -202,7 +246,11 @@ def _cost_row(x, y, i, ny, segments, squared, row):
                 row[j] += angle * angle
     if not squared:
         for j in range(ny):
-            row[j] = math.sqrt(row[j])
+            sq = row[j]
+            if sq < _TINY or sq > _HUGE:  # recompute without under- or overflow
+                row[j] = _robust_distance(xi, y[j], segments)
+            else:
+                row[j] = math.sqrt(sq)
 
 
 @njit(cache=True)

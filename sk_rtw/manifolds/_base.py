@@ -9,12 +9,15 @@ array of points has shape ``(*leading, *point_shape)``.
 
 from __future__ import annotations
 
+import functools
+import warnings
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
 import torch
+from sklearn.exceptions import ConvergenceWarning
 
 from .._backend import numpy_compatible, to_tensor
 from .._random import check_generator
@@ -23,10 +26,55 @@ from .._random import check_generator
 MEAN_TOL = 1e-10
 MEAN_MAX_ITER = 64
 
+#: Magnitudes beyond ``10 ** +-EXTREME_EXPONENT`` are aligned in a rescaled frame.
+EXTREME_EXPONENT = 100
+
 # Codes of the point distances that the numba DTW kernel knows (see sk_rtw.dtw).
 SEGMENT_EUCLIDEAN = 0
 SEGMENT_SPHERE = 1
 SEGMENT_SIGN_INVARIANT_SPHERE = 2
+
+
+def checked_geometry(points=(), vectors=(), broadcast=True):
+    """:func:`numpy_compatible`, plus argument checks for numpy (public) calls.
+
+    Arrays named in ``points`` must be finite points of the manifold, those in
+    ``vectors`` finite arrays of points' shape, and all of them broadcast against each
+    other (unless ``broadcast=False``, as for ``pairwise_dist``). Torch tensors -- the
+    engine's internal calls -- are not checked.
+    """
+    names = (*points, *vectors)
+
+    def decorate(method):
+        wrapped = numpy_compatible(method)
+
+        @functools.wraps(method)
+        def wrapper(self, *arrays, **kwargs):
+            if not any(isinstance(a, torch.Tensor) for a in arrays):
+                checked = [
+                    self._check_argument(a, name, name in points)
+                    for a, name in zip(arrays, names, strict=False)
+                ]
+                if broadcast and len(checked) > 1:
+                    _check_broadcast(self, dict(zip(names, checked, strict=False)))
+            return wrapped(self, *arrays, **kwargs)
+
+        return wrapper
+
+    return decorate
+
+
+def _check_broadcast(manifold, arrays: dict) -> None:
+    nd = manifold.point_ndim
+    leading = {name: a.shape[: a.ndim - nd] for name, a in arrays.items()}
+    try:
+        np.broadcast_shapes(*leading.values())
+    except ValueError:
+        text = ", ".join(f"{name} {a.shape}" for name, a in arrays.items())
+        raise ValueError(
+            f"the arguments do not broadcast against each other: {text} (points of "
+            f"{manifold!r} have shape {manifold.point_shape})"
+        ) from None
 
 
 @dataclass(frozen=True)
@@ -93,7 +141,7 @@ class Manifold(ABC):
         """Per-point boolean masks of violations (over leading axes) with a description."""
 
     # ------------------------------------------------------------- public API
-    @numpy_compatible
+    @checked_geometry(points=("p",), vectors=("v",))
     def exp(self, p, v):
         """Exponential map: the point reached from ``p`` along tangent vector ``v``.
 
@@ -110,7 +158,7 @@ class Manifold(ABC):
         """
         return self._exp(p, v)
 
-    @numpy_compatible
+    @checked_geometry(points=("p", "x"))
     def log(self, p, x):
         """Logarithmic map: the tangent vector at ``p`` pointing to ``x``.
 
@@ -125,7 +173,7 @@ class Manifold(ABC):
         """
         return self._log(p, x)
 
-    @numpy_compatible
+    @checked_geometry(points=("p", "x"))
     def dist(self, p, x):
         """Geodesic distance between ``p`` and ``x``.
 
@@ -139,7 +187,7 @@ class Manifold(ABC):
         """
         return self._dist(p, x)
 
-    @numpy_compatible
+    @checked_geometry(points=("p", "x"))
     def squared_dist(self, p, x):
         """Squared geodesic distance (smooth where the distance is zero).
 
@@ -153,7 +201,7 @@ class Manifold(ABC):
         """
         return self._dist(p, x) ** 2
 
-    @numpy_compatible
+    @checked_geometry(points=("p",), vectors=("v",))
     def norm(self, p, v):
         """Riemannian norm of the tangent vector ``v`` at ``p``.
 
@@ -170,7 +218,7 @@ class Manifold(ABC):
         """
         return self._norm(p, v)
 
-    @numpy_compatible
+    @checked_geometry(points=("A", "B"), broadcast=False)
     def pairwise_dist(self, A, B):
         """Geodesic distances between every point of ``A`` and every point of ``B``.
 
@@ -190,7 +238,7 @@ class Manifold(ABC):
         nd = self.point_ndim
         return self._dist(A.unsqueeze(-nd - 1), B.unsqueeze(-nd - 2))
 
-    @numpy_compatible
+    @checked_geometry(vectors=("X",))
     def project(self, X):
         """Nearest point on the manifold (normalise, symmetrise, clip eigenvalues, ...).
 
@@ -239,6 +287,8 @@ class Manifold(ABC):
         -------
         mean : same type as ``X``, shape of ``X`` without ``axis``.
         """
+        if not isinstance(X, torch.Tensor):
+            X = self._check_argument(X, "X", is_point=True)
         return numpy_compatible(_mean_impl)(
             self, X, weights, axis=axis, max_iter=max_iter, tol=tol
         )
@@ -277,6 +327,42 @@ class Manifold(ABC):
                     f"(tolerance {atol:g}); use {type(self).__name__}.project to map data "
                     "onto the manifold."
                 )
+
+    def _check_argument(self, value: Any, name: str, is_point: bool) -> np.ndarray:
+        try:
+            arr = np.asarray(value, dtype=np.float64)
+        except (TypeError, ValueError):
+            kind = type(value).__name__
+            raise TypeError(f"{name} must be a numeric array, got {kind}") from None
+        ps = self.point_shape
+        if arr.ndim < len(ps) or tuple(arr.shape[arr.ndim - len(ps) :]) != ps:
+            raise ValueError(
+                f"{name} has shape {arr.shape}, but points of {self!r} have shape {ps} "
+                f"(arrays of them: (..., {', '.join(map(str, ps))}))"
+            )
+        if is_point:
+            self.validate(arr, name=name)
+        elif not np.all(np.isfinite(arr)):
+            raise ValueError(f"{name} contains NaN or infinite values")
+        return arr
+
+    def extreme_scale(self, points: np.ndarray) -> float | None:
+        """A power of two to divide ``points`` by when their magnitude is extreme, or None.
+
+        Spaces where dividing points by a positive number maps the geometry onto itself
+        up to scale (R^d; SPD(k), whose affine-invariant metric does not change at all)
+        return one when the magnitudes lie beyond 1e+-100, so that squares and exponentials
+        neither overflow nor underflow; the others return None.
+
+        Parameters
+        ----------
+        points : ndarray of shape (..., *point_shape)
+
+        Returns
+        -------
+        factor : float or None
+        """
+        return None
 
     def continuous(self, series: Any) -> np.ndarray:
         """Representatives of a series that do not jump between equivalent points.
@@ -372,6 +458,14 @@ def _mean_impl(
         w = torch.full((n,), 1.0 / n, dtype=X.dtype, device=X.device)
     else:
         w = weights.to(dtype=X.dtype, device=X.device)
+        if w.ndim == 0 or w.shape[0] != n or w.ndim > n_leading:
+            raise ValueError(
+                f"weights must have {n} entries along the sample axis (shape ({n},) or "
+                f"broadcastable to the leading axes {tuple(X.shape[:n_leading])}), got shape "
+                f"{tuple(w.shape)}"
+            )
+        if not bool(torch.isfinite(w).all()):
+            raise ValueError("weights contain NaN or infinite values")
         if bool((w < 0).any()):
             raise ValueError("weights must be non-negative")
         total = w.sum(0)
@@ -385,4 +479,24 @@ def _mean_impl(
         M = manifold._exp(M, step)
         if tol > 0 and float(manifold._norm(M, step).max()) < tol:
             break
+    else:
+        if tol > 0:
+            warnings.warn(
+                f"the Fréchet mean did not converge in {max_iter} Gauss–Newton iterations "
+                f"(last step {float(manifold._norm(M, step).max()):.3g} > tol={tol:g}); "
+                "raise max_iter or check that the samples are not spread around the cut "
+                "locus",
+                ConvergenceWarning,
+                stacklevel=3,
+            )
     return M
+
+
+def power_of_two_scale(magnitude: float) -> float | None:
+    """``2 ** round(log2(magnitude))`` if ``magnitude`` is extreme (beyond 1e+-100)."""
+    if not np.isfinite(magnitude) or magnitude <= 0:
+        return None
+    exponent = np.log10(magnitude)
+    if -EXTREME_EXPONENT <= exponent <= EXTREME_EXPONENT:
+        return None
+    return float(2.0 ** np.round(np.log2(magnitude)))

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._backend import safe_norm
-from ._base import SEGMENT_EUCLIDEAN, Manifold
+from ._base import SEGMENT_EUCLIDEAN, Manifold, power_of_two_scale
 
 
 @dataclass(frozen=True)
@@ -49,6 +49,9 @@ class Euclidean(Manifold):
 
     def _project(self, x):
         return x
+
+    def extreme_scale(self, points):
+        return power_of_two_scale(float(np.abs(points).max(initial=0.0)))
 
     def _point_problems(self, x, atol):
         return []

@@ -81,7 +81,8 @@ _REGISTRY: dict[str, ManifoldSpec] = {
         ),
     ]
 }
-_FIXED_DIMENSION = {"quaternion", "pose"}
+#: Spaces with one dimension only, and that dimension (S^3; 3 + 3 for R^3 x S^3).
+_FIXED_DIMENSION = {"quaternion": 3, "pose": 6}
 
 
 def available_manifolds() -> dict[str, ManifoldSpec]:
@@ -141,6 +142,13 @@ def get_manifold(
     if key not in _REGISTRY:
         raise ValueError(f"unknown manifold {manifold!r}; choose one of {sorted(_REGISTRY)}")
     spec = _REGISTRY[key]
+    if dim is not None and key in _FIXED_DIMENSION:
+        fixed = spec.factory(None)
+        if dim != _FIXED_DIMENSION[key]:
+            raise ValueError(
+                f"{manifold!r} has a fixed dimension ({fixed!r}, points of shape "
+                f"{fixed.point_shape}); got dim={dim!r}. Leave dim out."
+            )
     if dim is None and key not in _FIXED_DIMENSION:
         if point_shape is None:
             raise ValueError(

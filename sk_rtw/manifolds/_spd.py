@@ -8,7 +8,7 @@ import numpy as np
 import torch
 
 from .._backend import safe_norm
-from ._base import Manifold
+from ._base import EXTREME_EXPONENT, Manifold, power_of_two_scale
 from ._euclidean import _check_dim
 from ._symmetric import sym, symmetric_function
 
@@ -62,6 +62,15 @@ class SPD(Manifold):
         si = symmetric_function(A, "invsqrt").unsqueeze(-3)
         inner = si @ B.unsqueeze(-4) @ si
         return safe_norm(symmetric_function(inner, "log"), dim=(-2, -1))
+
+    def extreme_scale(self, points):
+        eigenvalues = np.linalg.eigvalsh(points)
+        if not np.all(eigenvalues > 0):
+            return None
+        largest, smallest = float(eigenvalues.max()), float(eigenvalues.min())
+        if largest < 10.0**EXTREME_EXPONENT and smallest > 10.0**-EXTREME_EXPONENT:
+            return None
+        return power_of_two_scale(float(np.exp(np.log(eigenvalues).mean())))
 
     def _project(self, x):
         w, U = torch.linalg.eigh(sym(x))

@@ -27,6 +27,14 @@ def _sphere_exp(p: torch.Tensor, v: torch.Tensor) -> torch.Tensor:
     return cos * p + sinc * v
 
 
+def _antipodal_direction(p: torch.Tensor) -> torch.Tensor:
+    """A unit tangent vector at ``p``: the coordinate axis least aligned with ``p``,
+    made orthogonal to it (deterministic, so ``log(p, -p)`` is reproducible)."""
+    axis = torch.nn.functional.one_hot(p.abs().argmin(-1), p.shape[-1]).to(p.dtype)
+    d = axis - inner(axis, p, keepdim=True) * p
+    return d / torch.sqrt(inner(d, d, keepdim=True))
+
+
 def _sphere_log(p: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
     c = inner(p, x, keepdim=True)
     u = x - c * p
@@ -36,7 +44,10 @@ def _sphere_log(p: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
     safe_sq = torch.where(small, torch.ones_like(sq), sq.clamp_min(1e-300))
     s = torch.sqrt(safe_sq)
     factor = torch.where(small, 1.0 + sq / 6.0, torch.atan2(s, c) / s)
-    return factor * u
+    v = factor * u
+    # cut locus: x = -p has a geodesic of length pi in every direction; take a fixed one
+    antipodal = (sq < _TAYLOR_SQ) & (c < 0)  # no host sync: the branch is always computed
+    return torch.where(antipodal, math.pi * _antipodal_direction(p).expand_as(v), v)
 
 
 def _sphere_dist(p: torch.Tensor, x: torch.Tensor, sign_invariant: bool = False) -> torch.Tensor:
@@ -50,6 +61,10 @@ def _sphere_dist(p: torch.Tensor, x: torch.Tensor, sign_invariant: bool = False)
 @dataclass(frozen=True)
 class Sphere(Manifold):
     """Unit sphere S^d embedded in R^(d+1), with the great-circle metric.
+
+    At the cut locus (``x = -p``) every direction leads to ``x`` along a geodesic of
+    length pi; ``log(p, -p)`` returns the one along the coordinate axis least aligned
+    with ``p`` (made tangent), so that ``exp(p, log(p, -p)) = -p``.
 
     Parameters
     ----------
