@@ -14,8 +14,9 @@ lengths, and the manifold resolved against the data.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
+from types import GeneratorType
 from typing import Any
 
 import numpy as np
@@ -185,10 +186,10 @@ def check_series_collection(
             raise ValueError(f"{name} holds points of {X.manifold!r}, not of {manifold!r}")
         if X.n_series < min_series or int(X.lengths.min()) < min_length:
             raise ValueError(
-                f"{name} needs at least {min_series} series of at least {min_length} time "
-                "points"
+                f"{name} needs at least {min_series} series of at least {min_length} time points"
             )
         return X
+    _reject_unsupported_containers(X, name)
     if isinstance(X, (list, tuple)) and (len(X) == 0 or not _is_rectangular(X)):
         if len(X) == 0:
             raise ValueError(f"{name} is empty: at least {min_series} series are needed")
@@ -211,16 +212,29 @@ def check_series_collection(
             X = _to_float_array(X, name)
         # scikit-learn's checks and messages for sparse, complex, object, empty and 1-D input
         ndim = 2 if issparse(X) else np.asarray(X).ndim
-        arr = check_array(
-            X,
-            accept_sparse=False,
-            dtype="numeric",
-            ensure_all_finite=False,
-            allow_nd=True,
-            ensure_min_samples=max(1, min_series),
-            ensure_min_features=max(1, min_length) if ndim == 2 else 1,
-            input_name=name,
-        ).astype(np.float64, copy=False)
+        try:
+            arr = check_array(
+                X,
+                accept_sparse=False,
+                dtype="numeric",
+                ensure_all_finite=False,
+                allow_nd=True,
+                ensure_min_samples=max(1, min_series),
+                ensure_min_features=max(1, min_length) if ndim == 2 else 1,
+                input_name=name,
+            ).astype(np.float64, copy=False)
+        except ValueError as exc:  # say it in our words first, keep scikit-learn's after
+            message = str(exc)
+            if "feature(s)" in message:
+                message = f"{name} has too few time points per series: {message}"
+            elif "sample(s)" in message:
+                message = f"{name} has too few series: {message}"
+            else:
+                raise
+            raise ValueError(
+                f"{message} (a 'feature' is a time point and a 'sample' a series here)"
+            ) from None
+        _reject_channels_first(arr, manifold, name)
         manifold_obj = _resolve(manifold, arr, n_lead=2, name=name)
         if arr.ndim == 2 and manifold_obj.point_shape == (1,):
             arr = arr[:, :, None]
@@ -235,6 +249,52 @@ def check_series_collection(
         data[i, : len(s)] = s
         data[i, len(s) :] = s[-1]
     return SeriesCollection(data=data, lengths=lengths, manifold=manifold_obj)
+
+
+def _reject_unsupported_containers(X: Any, name: str) -> None:
+    """Clear errors for generators and sktime's nested DataFrames."""
+    if isinstance(X, (Iterator, GeneratorType)):
+        raise TypeError(
+            f"{name} is a {type(X).__name__}; pass an array or a list of series "
+            f"(e.g. list({name}))"
+        )
+    dtypes = getattr(X, "dtypes", None)
+    nested = dtypes is not None and any(np.dtype(d).kind == "O" for d in np.ravel(dtypes))
+    if nested and hasattr(X, "iloc"):
+        raise TypeError(
+            f"{name} is a DataFrame with object cells (sktime's nested layout?); convert it "
+            "to aeon's 3-D array (n_cases, n_channels, n_timepoints), e.g. with "
+            "aeon.utils.conversion.convert_collection(X, 'numpy3D'), then to sk_rtw's layout "
+            "with sk_rtw.utils.from_aeon"
+        )
+
+
+#: How to convert aeon data, for error messages.
+AEON_HINT = (
+    "sk_rtw is time-major, (n_series, n_timepoints[, n_channels]); aeon's channels-first "
+    "arrays (n_cases, n_channels, n_timepoints) convert with sk_rtw.utils.from_aeon(X)"
+)
+
+
+def _reject_channels_first(arr: np.ndarray, manifold: Any, name: str) -> None:
+    """A 3-D array read as Euclidean with fewer time points than channels is ambiguous.
+
+    aeon's ``(n_cases, n_channels, n_timepoints)`` would silently become series of
+    ``n_channels`` time points in R^n_timepoints. With a manifold given by name, such an
+    array is refused with the conversion to use; a ``Euclidean(d)`` object states the
+    layout and is accepted.
+    """
+    if not (isinstance(manifold, str) and manifold.lower() == "euclidean" and arr.ndim == 3):
+        return
+    n_time, n_channels = arr.shape[1], arr.shape[2]
+    if n_time < n_channels:
+        raise ValueError(
+            f"{name} has shape {arr.shape}: read time-major that is {n_time} time point(s) "
+            f"of {n_channels} channels, which looks like aeon's channels-first layout "
+            f"(n_cases={arr.shape[0]}, n_channels={n_time}, n_timepoints={n_channels}). "
+            f"{AEON_HINT}. If the layout really is (n, T, d) with T < d, pass "
+            f"manifold=Euclidean({n_channels})."
+        )
 
 
 def _is_rectangular(X: Sequence) -> bool:
