@@ -19,8 +19,10 @@ from __future__ import annotations
 import contextlib
 import os
 import threading
+from typing import Any
 
 import numba
+import numpy as np
 
 #: Serialises this package's multi-threaded numba launches.
 PARALLEL_LOCK = threading.RLock()
@@ -42,8 +44,22 @@ def select_threading_layer() -> str | None:
     return "workqueue"
 
 
+def check_n_jobs(n_jobs: Any) -> None:
+    """scikit-learn's rule: None or a non-zero integer (negative counts from the cores)."""
+    if n_jobs is None:
+        return
+    if isinstance(n_jobs, bool) or not isinstance(n_jobs, (int, np.integer)):
+        raise TypeError(f"n_jobs must be None or an integer, got {n_jobs!r}")
+    if n_jobs == 0:
+        raise ValueError(
+            "n_jobs must not be 0: use None or 1 for one thread, -1 for all cores, or a "
+            "positive count"
+        )
+
+
 def n_threads(n_jobs: int | None) -> int:
     """scikit-learn's ``n_jobs`` convention as a thread count (None: 1; -1: all cores)."""
+    check_n_jobs(n_jobs)
     if n_jobs is None or n_jobs == 1:
         count = 1
     elif n_jobs < 0:

@@ -22,9 +22,13 @@ __all__ = ["alignment_quality", "barycenter_loss", "restoration_accuracy"]
 
 def _sum_dtw_to(series: Any, reference: Any, manifold, normalize, window, n_jobs) -> float:
     collection = check_series_collection(series, manifold, name="series", min_length=1)
-    ref = check_series_collection(
-        [np.asarray(reference)], collection.manifold, name="reference", min_length=1
-    )
+    reference = np.asarray(reference)
+    if reference.ndim == 0:
+        raise ValueError(
+            f"the reference must be one series of shape (T, *point_shape), got the scalar "
+            f"{reference!r}"
+        )
+    ref = check_series_collection([reference], collection.manifold, name="reference", min_length=1)
     distances = dtw_pairwise_distance(
         collection, ref, normalize=normalize, window=window, n_jobs=n_jobs
     )

@@ -307,6 +307,30 @@ def resolve_config(
         warp_knots=check_int("warp_knots", value["warp_knots"], 2, allow_none=True),
         tangent_refinements=check_int("tangent_refinements", value["tangent_refinements"], 0),
         mean_iterations=check_int("mean_iterations", value["mean_iterations"], 1),
-        device=str(torch.device(device)),
+        device=check_device(device),
         cuda_graph=value["cuda_graph"],
     )
+
+
+def check_device(device: Any) -> str:
+    """A torch device that exists on this machine, as a string; clear errors otherwise."""
+    try:
+        resolved = torch.device(device)
+    except (RuntimeError, TypeError, ValueError):
+        raise ValueError(
+            f"device must be a torch device such as 'cpu', 'cuda' or 'cuda:0', got {device!r}"
+        ) from None
+    if resolved.type == "cuda" and not torch.cuda.is_available():
+        build = "a CPU-only build" if torch.version.cuda is None else "a CUDA build"
+        raise ValueError(
+            f"device={device!r}, but torch finds no CUDA device (torch {torch.__version__} is "
+            f"{build}); use device='cpu' or install a CUDA build of torch on a GPU machine"
+        )
+    if resolved.type == "cuda" and resolved.index is not None:
+        if resolved.index >= torch.cuda.device_count():
+            raise ValueError(
+                f"device={device!r}, but only {torch.cuda.device_count()} CUDA device(s) exist"
+            )
+    if resolved.type == "mps" and not torch.backends.mps.is_available():
+        raise ValueError(f"device={device!r}, but torch finds no MPS device")
+    return str(resolved)

@@ -10,11 +10,12 @@ import numpy as np
 import torch
 
 from .._random import check_generator
+from .._resources import available_memory, format_bytes
 from ..manifolds import Manifold
 from ..utils import SeriesCollection, check_series_collection
 from ._config import AlignmentConfig, resolve_config
 from ._loss import monotonicity_penalty, window_loss, window_weights
-from ._sinc import SincInterpolator
+from ._sinc import TABLE_BYTES, SincInterpolator
 from ._start import dtw_start
 from ._training import Trainer, progress_printer
 from ._warps import NeuralWarps, SineWarps, compose_warps, unit_time
@@ -225,9 +226,16 @@ def align(
         warp_start="given" if given_start is not None else warp_start,
         method_options=method_options,
     )
+    check_memory(collection, config)
     start = time.perf_counter()
     rng = check_generator(random_state)
     seed = int(rng.integers(2**31 - 1))
+    # magnitudes beyond 1e+-100: align in a frame rescaled by a power of two
+    scale = collection.manifold.extreme_scale(collection.data)
+    if scale is not None:
+        collection = SeriesCollection(
+            data=collection.data / scale, lengths=collection.lengths, manifold=collection.manifold
+        )
     with torch.random.fork_rng(devices=[]):
         torch.manual_seed(seed)
         model = _build_warps(config, n_signals).to(config.device)
@@ -249,9 +257,10 @@ def align(
         best_epoch = _optimise(problem, model, history, verbose)
     with torch.no_grad():
         _, warps, aligned, mean = problem.forward(model)
+    factor = 1.0 if scale is None else scale
     return Alignment(
-        mean=collection.manifold.continuous(mean.cpu().numpy()),
-        aligned=collection.manifold.continuous(aligned.cpu().numpy()),
+        mean=collection.manifold.continuous(mean.cpu().numpy() * factor),
+        aligned=collection.manifold.continuous(aligned.cpu().numpy() * factor),
         warps=warps.cpu().numpy(),
         loss_history=history,
         best_epoch=best_epoch,
@@ -259,6 +268,37 @@ def align(
         config=config,
         fit_time=time.perf_counter() - start,
     )
+
+
+def estimated_memory(collection: SeriesCollection, config: AlignmentConfig) -> int:
+    """Rough peak bytes of an alignment: activations kept for the backward pass.
+
+    Per output point and series: the interpolated point and its derivative, the
+    distances, and for curved spaces the Gauss–Newton iterations of the mean; the table
+    of window vectors; the network's activations at its evaluation times.
+    """
+    n_series, t_max = collection.n_series, collection.max_length
+    z = config.output_length
+    point = max(1, collection.data[0, 0].size)
+    curved = not collection.manifold.is_flat
+    per_point = 8 * (point * (6 + (4 * config.mean_iterations if curved else 0)) + 8)
+    taps = t_max if config.sinc_window is None else 2 * config.sinc_window + 1
+    table = min(8 * n_series * t_max * taps * point, TABLE_BYTES)
+    times = z if config.warp_knots is None else min(z, config.warp_knots)
+    network = 8 * 3 * times * (2 * config.hidden_size + 1 + n_series) + 8 * 4 * z * n_series
+    return n_series * z * per_point + table + network
+
+
+def check_memory(collection: SeriesCollection, config: AlignmentConfig) -> None:
+    """``MemoryError`` naming the sizes when an alignment cannot fit in memory."""
+    need, free = estimated_memory(collection, config), available_memory()
+    if need > free:
+        raise MemoryError(
+            f"aligning {collection.n_series} series to output_length Z={config.output_length} "
+            f"needs about {format_bytes(need)}, more than the {format_bytes(free)} of memory "
+            "available: lower output_length (the paper preset uses N T_max), align fewer "
+            "series at once, or use warp_knots"
+        )
 
 
 def _check_warps(warps: Any, n_signals: int, output_length: int | None) -> np.ndarray:

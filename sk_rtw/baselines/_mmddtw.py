@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import itertools
 import math
-import os
 from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
+from .._resources import available_memory
 from ..dtw._dtw import _check_window, point_cost_matrix
 from ..manifolds import SPD, Euclidean, Manifold
 from ..utils import check_series_collection
@@ -19,14 +19,6 @@ from ._result import MultipleAlignment, make_result
 METRICS = ("geodesic", "cholesky")
 
 PairCost = Callable[[int, int], np.ndarray]
-
-
-def available_memory() -> int:
-    """Physical memory currently available, in bytes (total memory where unknown)."""
-    try:
-        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
-    except (ValueError, OSError, AttributeError):  # pragma: no cover - non-POSIX
-        return 8 * 2**30
 
 
 def grid_bytes(lengths) -> int:
@@ -46,6 +38,12 @@ def grid_bytes(lengths) -> int:
 
 
 def _check_memory(lengths, max_memory: int | None) -> None:
+    if max_memory is not None and (
+        isinstance(max_memory, bool)
+        or not isinstance(max_memory, (int, float, np.integer, np.floating))
+        or not max_memory > 0
+    ):
+        raise ValueError(f"max_memory must be a positive number of bytes, got {max_memory!r}")
     limit = available_memory() if max_memory is None else int(max_memory)
     need = grid_bytes(lengths)
     if need > limit:

@@ -20,14 +20,15 @@ from . import _kernels
 _NORMALIZE = (None, "path")
 
 
-def _check_window(window: float | None) -> float:
+def _check_window(window: float | None, name: str = "window") -> float:
     if window is None:
         return -1.0
-    if isinstance(window, bool) or not isinstance(window, (int, float, np.floating)):
-        raise TypeError(f"window must be a float in [0, 1] or None, got {window!r}")
+    if isinstance(window, bool) or not isinstance(window, (int, float, np.integer, np.floating)):
+        raise TypeError(f"{name} must be a float in [0, 1] or None, got {window!r}")
     if not 0.0 <= float(window) <= 1.0:
         raise ValueError(
-            f"window must lie in [0, 1] (fraction of the shorter series), got {window}"
+            f"{name} must lie in [0, 1] (Sakoe–Chiba radius as a fraction of the shorter "
+            f"series), got {window}"
         )
     return float(window)
 

@@ -13,10 +13,13 @@ from sklearn.utils import check_random_state, column_or_1d
 from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted
 
+from .._numba import check_n_jobs
+from .._random import check_random_state_value
 from ..align import METHODS, align, classification_output_length
 from ..align._config import check_preset
 from ..baselines import dba_average
 from ..dtw import dtw_pairwise_distance
+from ..dtw._dtw import _check_window as check_window
 from ..manifolds import Manifold
 from ..utils import SeriesCollection, check_series_collection
 
@@ -188,6 +191,9 @@ class RTWAverager(TransformerMixin, BaseEstimator):
     def _fit_means(self, X, y, require_two_classes):
         method = self._resolve_method()
         check_preset(self.preset)
+        check_random_state_value(self.random_state)
+        check_n_jobs(self.n_jobs)
+        check_window(self.dtw_window, name="dtw_window")  # in fit, not only at predict
         collection = check_series_collection(X, self.manifold)
         if y is None:
             labels = np.zeros(collection.n_series, dtype=int)
@@ -290,7 +296,7 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         distances : ndarray of shape (n_series, n_classes)
         """
         check_is_fitted(self, "means_")
-        collection = check_series_collection(X, self.manifold_)
+        collection = check_series_collection(X, self.manifold_, min_length=1)
         means = check_series_collection(self.means_, self.manifold_, name="means_")
         return dtw_pairwise_distance(collection, means, window=self.dtw_window, n_jobs=self.n_jobs)
 
@@ -329,11 +335,16 @@ def _check_labels(y: Any, n_series: int, classification: bool) -> np.ndarray:
     labels = column_or_1d(y, warn=True)
     if len(labels) != n_series:
         raise ValueError(f"X has {n_series} series but y has {len(labels)} labels")
+    if labels.dtype == object:
+        for i, value in enumerate(labels.tolist()):
+            if value is None or (isinstance(value, float) and np.isnan(value)):
+                raise ValueError(f"y[{i}] is {value!r}: labels must not be missing (None or NaN)")
     mixed = labels.dtype == object and len({type(v) for v in labels.tolist()}) > 1
     if classification and not mixed:  # scikit-learn cannot sort mixed str/int labels
         check_classification_targets(labels)
     elif labels.dtype.kind == "f" and np.isnan(labels).any():
-        raise ValueError("y contains NaN labels")
+        first = int(np.argmax(np.isnan(labels)))
+        raise ValueError(f"y[{first}] is NaN: labels must not be missing")
     return labels
 
 

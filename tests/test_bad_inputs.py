@@ -1,0 +1,402 @@
+"""Bad and edge inputs across the public API: a clear error naming the problem, or the
+correct answer. One case per item of the reliability catalogue, and more."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pandas as pd
+import pytest
+from sklearn.exceptions import ConvergenceWarning, NotFittedError
+
+from sk_rtw import (
+    SPD,
+    Euclidean,
+    Product,
+    Quaternion,
+    RTWNearestCentroid,
+    Sphere,
+    align,
+    dtw_distance,
+    dtw_pairwise_distance,
+    get_manifold,
+    metrics,
+)
+from sk_rtw.baselines import dba_average, mmddtw_align
+from sk_rtw.datasets import make_warped_signals
+from sk_rtw.utils import from_aeon, from_tslearn, to_aeon
+
+RNG = np.random.default_rng(0)
+UNI = RNG.standard_normal((6, 20))  # 6 univariate series
+LABELS = np.array([0, 0, 0, 1, 1, 1])
+S2 = Sphere(2)
+P2 = S2.random_point(5, random_state=1)
+QUAT = make_warped_signals(Quaternion(), 3, 20, 0).signals
+SPD_SERIES = make_warped_signals(SPD(2), 3, 20, 0).signals
+FAST = {"n_epochs": 2, "hidden_size": 8, "random_state": 0}
+
+
+def fit_classifier(X, y=LABELS, **params):
+    return RTWNearestCentroid(**{**FAST, **params}).fit(X, y)
+
+
+def fitted():
+    return fit_classifier(UNI)
+
+
+# (id, call, exception type, words the message must contain)
+ERRORS = [
+    # ---- silently wrong before: now a clear error
+    (
+        "aeon channels-first multivariate",
+        lambda: fit_classifier(np.zeros((6, 6, 100))),
+        ValueError,
+        "from_aeon",
+    ),
+    (
+        "aeon channels-first univariate",
+        lambda: align(np.zeros((6, 1, 150))),
+        ValueError,
+        "channels-first",
+    ),
+    (
+        "quaternion with another dim",
+        lambda: get_manifold("quaternion", dim=7),
+        ValueError,
+        "fixed dimension",
+    ),
+    ("pose with another dim", lambda: get_manifold("pose", dim=2), ValueError, "fixed dimension"),
+    (
+        "SPD dist of an indefinite matrix",
+        lambda: SPD(2).dist(np.diag([1.0, -1.0]), np.eye(2)),
+        ValueError,
+        "positive definite",
+    ),
+    (
+        "Euclidean dist with NaN",
+        lambda: Euclidean(2).dist(np.array([np.nan, 0.0]), np.zeros(2)),
+        ValueError,
+        "NaN",
+    ),
+    (
+        "Sphere mean with a NaN sample",
+        lambda: S2.mean(np.vstack([P2, [np.nan, 0.0, 1.0]])),
+        ValueError,
+        "NaN",
+    ),
+    (
+        "Sphere(2) dist on S^3 points",
+        lambda: S2.dist(np.ones((3, 4)) / 2, np.ones((3, 4)) / 2),
+        ValueError,
+        "shape (3,)",
+    ),
+    (
+        "None among string labels",
+        lambda: fit_classifier(UNI, ["a", "a", None, "b", "b", "b"]),
+        ValueError,
+        "None",
+    ),
+    (
+        "NaN among string labels",
+        lambda: fit_classifier(UNI, np.array(["a", "a", np.nan, "b", "b", "b"], dtype=object)),
+        ValueError,
+        "nan",
+    ),
+    (
+        "NaN float labels",
+        lambda: fit_classifier(UNI, [0.0, 0.0, np.nan, 1.0, 1.0, 1.0]),
+        ValueError,
+        "NaN",
+    ),
+    # ---- unclear errors before: now in the library's words
+    ("align given a generator", lambda: align(s for s in UNI), TypeError, "generator"),
+    ("estimator given a generator", lambda: fit_classifier(iter(UNI)), TypeError, "iterator"),
+    ("huge output_length", lambda: align(UNI, output_length=10**9), MemoryError, "GiB"),
+    ("device cuda without CUDA", lambda: align(UNI, device="cuda:7"), ValueError, "CUDA"),
+    ("device gpu", lambda: align(UNI, device="gpu"), ValueError, "torch device"),
+    ("align random_state=-1", lambda: align(UNI, random_state=-1), ValueError, "random_state"),
+    (
+        "estimator random_state=-1",
+        lambda: fit_classifier(UNI, random_state=-1),
+        ValueError,
+        "random_state",
+    ),
+    ("random_state as a float", lambda: align(UNI, random_state=1.5), TypeError, "random_state"),
+    ("pairwise DTW n_jobs=0", lambda: dtw_pairwise_distance(UNI, n_jobs=0), ValueError, "n_jobs"),
+    (
+        "pairwise DTW n_jobs=1.5",
+        lambda: dtw_pairwise_distance(UNI, n_jobs=1.5),
+        TypeError,
+        "n_jobs",
+    ),
+    ("estimator n_jobs=0", lambda: fit_classifier(UNI, n_jobs=0), ValueError, "n_jobs"),
+    ("wrong number of weights in mean", lambda: S2.mean(P2, np.ones(3)), ValueError, "weights"),
+    ("negative weights in mean", lambda: S2.mean(P2, -np.ones(5)), ValueError, "non-negative"),
+    ("NaN weights in mean", lambda: S2.mean(P2, np.full(5, np.nan)), ValueError, "NaN"),
+    ("mismatched shapes in exp", lambda: S2.exp(P2, np.zeros((4, 3))), ValueError, "broadcast"),
+    (
+        "tangent vector of the wrong size",
+        lambda: S2.exp(P2, np.zeros((5, 2))),
+        ValueError,
+        "shape",
+    ),
+    (
+        "scalar reference in a metric",
+        lambda: metrics.barycenter_loss(UNI, 3.0),
+        ValueError,
+        "scalar",
+    ),
+    (
+        "sktime nested DataFrame",
+        lambda: align(pd.DataFrame({"dim_0": [pd.Series(np.arange(5.0)) for _ in range(3)]})),
+        TypeError,
+        "nested",
+    ),
+    # ---- validated in fit, not only at predict time
+    ("dtw_window=2 at fit", lambda: fit_classifier(UNI, dtw_window=2), ValueError, "dtw_window"),
+    (
+        "mmddtw max_memory=-1",
+        lambda: mmddtw_align(UNI[:2], max_memory=-1),
+        ValueError,
+        "max_memory",
+    ),
+    # ---- messages in time points and series
+    ("one time point per series", lambda: align(np.zeros((3, 1))), ValueError, "time points"),
+    ("no series", lambda: align(np.zeros((0, 5))), ValueError, "series"),
+    # ---- more of our own
+    ("empty list", lambda: align([]), ValueError, "empty"),
+    ("string data", lambda: align(np.array([["a", "b"], ["c", "d"]])), ValueError, "numeric"),
+    ("complex data", lambda: align(np.ones((2, 5)) * 1j), ValueError, "omplex"),
+    (
+        "infinite value",
+        lambda: align(np.array([[0.0, np.inf, 1.0], [0.0, 1.0, 2.0]])),
+        ValueError,
+        "infinite",
+    ),
+    (
+        "ragged point shapes",
+        lambda: align([np.zeros((5, 2)), np.zeros((5, 3))]),
+        ValueError,
+        "shape",
+    ),
+    (
+        "off-sphere data",
+        lambda: align(np.ones((2, 5, 3)), manifold="sphere"),
+        ValueError,
+        "not a point",
+    ),
+    (
+        "non-unit quaternions",
+        lambda: align(2 * QUAT, manifold="quaternion"),
+        ValueError,
+        "not a point",
+    ),
+    (
+        "non-symmetric SPD",
+        lambda: align(SPD_SERIES + np.array([[0, 1.0], [0, 0]]), manifold="spd"),
+        ValueError,
+        "symmetric",
+    ),
+    ("unknown manifold", lambda: align(UNI, manifold="torus"), ValueError, "unknown manifold"),
+    ("manifold of the wrong type", lambda: align(UNI, manifold=3), TypeError, "manifold"),
+    ("unknown method", lambda: align(UNI, method="dtw"), ValueError, "method"),
+    ("unknown preset", lambda: align(UNI, preset="fast"), ValueError, "preset"),
+    ("unknown option", lambda: align(UNI, bogus=1), TypeError, "bogus"),
+    ("n_epochs as a float", lambda: align(UNI, n_epochs=1.5), ValueError, "n_epochs"),
+    ("NaN learning rate", lambda: align(UNI, learning_rate=np.nan), ValueError, "learning_rate"),
+    ("negative sinc window", lambda: align(UNI, sinc_window=-1), ValueError, "sinc_window"),
+    ("warp_knots=1", lambda: align(UNI, warp_knots=1), ValueError, "warp_knots"),
+    ("unknown warp start", lambda: align(UNI, warp_start="medoid"), ValueError, "warp_start"),
+    (
+        "warp start of the wrong shape",
+        lambda: align(UNI, warp_start=np.zeros((2, 5))),
+        ValueError,
+        "warp_start",
+    ),
+    ("unknown init", lambda: align(UNI, init="he"), ValueError, "init"),
+    ("cuda_graph not a bool", lambda: align(UNI, cuda_graph="yes"), ValueError, "cuda_graph"),
+    ("labels of the wrong length", lambda: fit_classifier(UNI, [0, 1]), ValueError, "labels"),
+    (
+        "one class for a classifier",
+        lambda: fit_classifier(UNI, np.zeros(6)),
+        ValueError,
+        "2 classes",
+    ),
+    ("unknown estimator method", lambda: fit_classifier(UNI, method="knn"), ValueError, "method"),
+    ("predict before fit", lambda: RTWNearestCentroid().predict(UNI), NotFittedError, "fit"),
+    (
+        "predict on another manifold's points",
+        lambda: fitted().predict(np.zeros((2, 5, 3))),
+        ValueError,
+        "shape",
+    ),
+    ("DTW window 1.5", lambda: dtw_distance(UNI[0], UNI[1], window=1.5), ValueError, "window"),
+    (
+        "DTW window as a string",
+        lambda: dtw_distance(UNI[0], UNI[1], window="10%"),
+        TypeError,
+        "window",
+    ),
+    (
+        "DTW normalize unknown",
+        lambda: dtw_distance(UNI[0], UNI[1], normalize="max"),
+        ValueError,
+        "normalize",
+    ),
+    (
+        "DTW between different dimensions",
+        lambda: dtw_distance(np.zeros((5, 3)), np.zeros((5, 2))),
+        ValueError,
+        "shape",
+    ),
+    ("Sphere(dim=0)", lambda: Sphere(0), ValueError, "dim"),
+    ("SPD(dim=1.5)", lambda: SPD(1.5), ValueError, "dim"),
+    ("empty product", lambda: Product(()), ValueError, "Product"),
+    (
+        "zero signals to generate",
+        lambda: make_warped_signals("sphere", 0, 20),
+        ValueError,
+        "n_signals",
+    ),
+    ("DBA with n_iter=0", lambda: dba_average(UNI, n_iter=0), ValueError, "n_iter"),
+    ("aeon conversion of a 2-D array", lambda: from_aeon(np.zeros((3, 5))), ValueError, "3-D"),
+    (
+        "tslearn array with an empty series",
+        lambda: from_tslearn(np.full((2, 4, 1), np.nan)),
+        ValueError,
+        "NaN everywhere",
+    ),
+]
+
+
+@pytest.mark.parametrize(("call", "error", "words"), [c[1:] for c in ERRORS],
+                         ids=[c[0] for c in ERRORS])  # fmt: skip
+def test_bad_input_gives_a_clear_error(call, error, words):
+    with pytest.raises(error) as info:
+        call()
+    assert words.lower() in str(info.value).lower(), str(info.value)
+
+
+def test_catalogue_is_large():
+    assert len(ERRORS) + len(CORRECT) >= 60
+
+
+# ----------------------------------------------------------------- right answers
+def dtw_scales_linearly(scale):
+    x, y = np.array([0.0, 1.0, 2.0]), np.array([0.0, 0.0, 1.0, 3.0])
+    for X, Y in ((x, y), (np.c_[x, -x], np.c_[y, -y])):
+        expected = dtw_distance(X, Y)
+        assert dtw_distance(scale * X, scale * Y) == pytest.approx(scale * expected, rel=1e-12)
+
+
+def barycenter_loss_scales_linearly(scale):
+    mean = UNI.mean(0)
+    expected = metrics.barycenter_loss(UNI, mean)
+    assert metrics.barycenter_loss(scale * UNI, scale * mean) == pytest.approx(
+        scale * expected, rel=1e-12
+    )
+
+
+def align_at_scale(scale):
+    data = make_warped_signals("euclidean", 4, 40, 1).signals
+    factor = Euclidean(1).extreme_scale(scale * data)
+    assert factor is not None
+    result = align(scale * data, n_epochs=30, random_state=0)
+    reference = align(scale * data / factor, n_epochs=30, random_state=0)  # the same frame
+    np.testing.assert_allclose(result.warps, reference.warps, atol=1e-12)
+    np.testing.assert_allclose(result.mean, reference.mean * factor, rtol=1e-9)
+    assert result.best_epoch > 0  # the warps were trained, not left at their start
+
+
+def align_spd_at_scale(scale):
+    data = make_warped_signals(SPD(2), 3, 25, 2).signals
+    result = align(scale * data, manifold="spd", n_epochs=5, random_state=0)
+    plain = align(data, manifold="spd", n_epochs=5, random_state=0)
+    assert np.all(np.isfinite(result.mean))
+    # the affine-invariant metric ignores the scale: the same warps, the mean scaled
+    np.testing.assert_allclose(result.warps, plain.warps, atol=1e-3)
+    np.testing.assert_allclose(result.mean / scale, plain.mean, rtol=1e-2)
+
+
+def sphere_log_at_the_antipode():
+    for M in (Sphere(1), Sphere(2), Sphere(5)):
+        p = M.random_point(random_state=3)
+        v = M.log(p, -p)
+        assert np.linalg.norm(v) == pytest.approx(np.pi)
+        assert abs(v @ p) < 1e-12  # tangent
+        np.testing.assert_allclose(M.exp(p, v), -p, atol=1e-12)
+        np.testing.assert_array_equal(v, M.log(p, -p))  # deterministic
+
+
+def quaternion_log_at_minus_q_is_zero():
+    q = Quaternion().random_point(random_state=4)
+    np.testing.assert_allclose(Quaternion().log(q, -q), 0.0, atol=1e-12)
+
+
+def predict_length_one_series():
+    clf = fitted()
+    assert clf.predict([np.array([0.3]), np.array([1.0, 2.0])]).shape == (2,)
+
+
+def n_jobs_all_and_more_than_cores():
+    expected = dtw_pairwise_distance(UNI)
+    np.testing.assert_array_equal(dtw_pairwise_distance(UNI, n_jobs=-1), expected)
+    np.testing.assert_array_equal(dtw_pairwise_distance(UNI, n_jobs=64), expected)
+
+
+def mean_warns_when_not_converged():
+    X = S2.random_point(7, random_state=5)
+    with pytest.warns(ConvergenceWarning, match="did not converge"):
+        S2.mean(X, max_iter=1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        S2.mean(X, max_iter=1, tol=0.0)  # a fixed number of steps asked for: no warning
+
+
+def aeon_round_trip():
+    X = RNG.standard_normal((5, 3, 40))
+    np.testing.assert_array_equal(to_aeon(from_aeon(X)), X)
+    assert from_aeon(X).shape == (5, 40, 3)
+    assert from_aeon(X[:, :1]).shape == (5, 40)
+    unequal = [RNG.standard_normal((2, n)) for n in (10, 12)]
+    assert [s.shape for s in from_aeon(unequal)] == [(10, 2), (12, 2)]
+
+
+def tslearn_padding_becomes_unequal_lengths():
+    X = np.full((2, 6, 1), np.nan)
+    X[0, :6, 0] = np.arange(6.0)
+    X[1, :4, 0] = np.arange(4.0)
+    series = from_tslearn(X)
+    assert [len(s) for s in series] == [6, 4]
+    assert fit_classifier([*series, *series], [0, 1, 0, 1]).predict(series).shape == (2,)
+
+
+def channels_first_is_fine_when_the_layout_is_stated():
+    X = np.zeros((4, 3, 10))  # 3 time points of R^10, on purpose
+    assert align(X, manifold=Euclidean(10), n_epochs=1).mean.shape == (12, 10)
+
+
+CORRECT = [
+    ("DTW at 1e200", lambda: dtw_scales_linearly(1e200)),
+    ("DTW at 1e-300", lambda: dtw_scales_linearly(1e-300)),
+    ("barycenter loss at 1e200", lambda: barycenter_loss_scales_linearly(1e200)),
+    ("barycenter loss at 1e-300", lambda: barycenter_loss_scales_linearly(1e-300)),
+    ("align at 1e200", lambda: align_at_scale(1e200)),
+    ("align at 1e-300", lambda: align_at_scale(1e-300)),
+    ("align SPD at 1e150", lambda: align_spd_at_scale(1e150)),
+    ("align SPD at 1e-150", lambda: align_spd_at_scale(1e-150)),
+    ("sphere log at the antipode", sphere_log_at_the_antipode),
+    ("quaternion log at -q", quaternion_log_at_minus_q_is_zero),
+    ("predict on length-1 series", predict_length_one_series),
+    ("n_jobs=-1 and above the core count", n_jobs_all_and_more_than_cores),
+    ("Fréchet mean at max_iter warns", mean_warns_when_not_converged),
+    ("aeon round trip", aeon_round_trip),
+    ("tslearn NaN padding", tslearn_padding_becomes_unequal_lengths),
+    ("stated layout with T < d", channels_first_is_fine_when_the_layout_is_stated),
+]
+
+
+@pytest.mark.parametrize("check", [c[1] for c in CORRECT], ids=[c[0] for c in CORRECT])
+def test_valid_input_gives_the_right_answer(check):
+    check()
