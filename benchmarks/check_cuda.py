@@ -41,9 +41,7 @@ SPACES = [
 
 
 def compare(reference, other) -> tuple[float, float, float, float]:
-    first = abs(reference.loss_history[0] - other.loss_history[0]) / abs(
-        reference.loss_history[0]
-    )
+    first = abs(reference.loss_history[0] - other.loss_history[0]) / abs(reference.loss_history[0])
     history = np.max(
         np.abs(reference.loss_history - other.loss_history) / np.abs(reference.loss_history)
     )
@@ -78,9 +76,7 @@ def main() -> int:
                     + (f" [{notes}]" if notes else ""),
                     flush=True,
                 )
-    X = np.concatenate(
-        [make_warped_signals(Quaternion(), 8, 40, seed).signals for seed in (1, 2)]
-    )
+    X = np.concatenate([make_warped_signals(Quaternion(), 8, 40, seed).signals for seed in (1, 2)])
     y = np.repeat([0, 1], 8)
     for estimator in (
         RTWNearestCentroid(manifold="quaternion", n_epochs=20, random_state=0, device="cuda"),

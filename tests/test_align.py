@@ -479,7 +479,23 @@ def test_path_warp_is_the_mean_matched_position():
 
     path = np.array([[0, 0], [1, 1], [1, 2], [1, 3], [2, 4], [3, 4], [4, 5]])
     expected = np.array([0.0, 2.0, 4.0, 4.0, 5.0]) / 5
-    np.testing.assert_allclose(path_warp(path, 5, 6), expected)
+    np.testing.assert_allclose(path_warp(path, 5, 6, smoothing=0), expected)
+
+
+def test_smoothed_path_warps_stay_monotone_from_zero_to_one(rng):
+    from sk_rtw.align._start import path_warp
+
+    matched = np.sort(rng.integers(0, 80, 60))  # a staircase with flat and steep parts
+    matched[0], matched[-1] = 0, 79
+    path = np.stack([np.arange(60), matched], axis=1)
+    raw, smooth = path_warp(path, 60, 80, 0), path_warp(path, 60, 80, 2.0)
+    assert smooth[0] == 0.0 and smooth[-1] == 1.0
+    assert np.all(np.diff(smooth) >= 0)
+    assert np.abs(np.diff(smooth, 2)).max() < np.abs(np.diff(raw, 2)).max()  # fewer corners
+    assert np.abs(smooth - raw).max() < 5 / 79  # within a few samples of the path
+    short = path_warp(np.array([[0, 0], [1, 2], [2, 2], [3, 3], [4, 4]]), 5, 5, 2.0)
+    assert short.shape == (5,) and short[0] == 0.0 and short[-1] == 1.0  # radius > length
+    assert np.all(np.diff(short) >= 0)
 
 
 def test_centred_warps_average_to_the_identity(rng):

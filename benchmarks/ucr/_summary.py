@@ -111,8 +111,7 @@ def markdown(records: list[dict], methods: list[str], command: str, machine: str
         lines.append("")
     if "rtw" in methods:
         lines += [
-            "## RTW against each method: datasets where RTW's accuracy is higher / equal / "
-            "lower",
+            "## RTW against each method: datasets where RTW's accuracy is higher / equal / lower",
             "",
             "| method | RTW wins | ties | RTW losses | n | mean accuracy (RTW vs method) |",
             "| --- | --- | --- | --- | --- | --- |",
