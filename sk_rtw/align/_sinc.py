@@ -142,10 +142,13 @@ class SincInterpolator:
             return None
         with torch.no_grad():
             centres = torch.arange(t_max, device=self.data.device).expand(n_series, -1)
-            samples = self._window_samples(centres)
             if flat:
-                return samples
-            return self._logs(self.data, samples)
+                return self._window_samples(centres)
+            table = self.data.new_empty(n_series, t_max, self.n_taps, *self.point_shape)
+            for part in self._chunks(t_max):  # the logs' temporaries stay chunk-sized
+                samples = self._window_samples(centres[:, part])
+                table[:, part] = self._logs(self.data[:, part], samples)
+            return table
 
     # -------------------------------------------------------------- geometry
     def _window_samples(self, base: torch.Tensor) -> torch.Tensor:
