@@ -83,15 +83,47 @@ def dba_seconds(X: np.ndarray, repeats: int) -> float:
     )
 
 
+DBA_PROBE = """
+import json, statistics, sys, time
+import numpy as np
+from aeon.clustering.averaging import elastic_barycenter_average
+from sk_rtw.datasets import make_warped_signals
+X = np.asarray(make_warped_signals("euclidean", 30, 100, random_state=0).signals)
+X = np.swapaxes(X, 1, 2)
+times = []
+for _ in range(int(sys.argv[1]) + 1):
+    start = time.perf_counter()
+    elastic_barycenter_average(X, distance="dtw", random_state=0)
+    times.append(time.perf_counter() - start)
+print(json.dumps({"seconds": statistics.median(times[1:])}))
+"""
+
+
+def dba_fresh_process_seconds(repeats: int) -> float:
+    """aeon's DBA in a fresh process on numba's default threading layer (OpenMP here)."""
+    env = {**os.environ, "NUMBA_THREADING_LAYER": "default"}  # sk_rtw then keeps it
+    out = subprocess.run(
+        [sys.executable, "-c", DBA_PROBE, str(repeats)],
+        capture_output=True, text=True, check=True, env=env,
+    )  # fmt: skip
+    return json.loads(out.stdout.strip().splitlines()[-1])["seconds"]
+
+
 def section_fits(device: str, repeats: int) -> None:
     X = np.asarray(make_warped_signals("euclidean", 30, T, random_state=0).signals)
     dba = dba_seconds(X, repeats)
+    alone = dba_fresh_process_seconds(repeats)
     print(f"\n1. Full fits, N = 30 Euclidean series, T = {T}, 256 epochs, defaults")
-    print(f"{'method':>8} {'seconds':>9} {'x DBA':>7}")
-    print(f"{'aeon DBA':>8} {dba:>9.3f} {1.0:>7.1f}")
+    print(f"{'method':>8} {'seconds':>9} {'x DBA':>7} {'x DBA alone':>12}")
+    print(f"{'aeon DBA':>8} {dba:>9.3f} {1.0:>7.1f} {dba / alone:>12.1f}")
     for method in METHODS:
         seconds = timed(lambda m=method: fit(X, "euclidean", m, 256, device), repeats)
-        print(f"{method:>8} {seconds:>9.3f} {seconds / dba:>7.1f}", flush=True)
+        print(f"{method:>8} {seconds:>9.3f} {seconds / dba:>7.1f} {seconds / alone:>12.1f}",
+              flush=True)  # fmt: skip
+    print(
+        f"   x DBA: aeon's DBA in this process ({dba:.3f} s); x DBA alone: in a fresh process "
+        f"on numba's default threading layer ({alone:.3f} s; see docs/benchmarks/align_speed)"
+    )
 
 
 def per_epoch_ms(X, manifold, method, device, epochs, repeats) -> float:

@@ -124,7 +124,7 @@ def main(argv=None) -> None:
             results = run(
                 n_signals, methods, args.trials, args.epochs, output_length, args.device, args.seed
             )
-            z = output_length or min(n_signals, 4) * T
+            z = output_length or f"{min(n_signals, 4) * T} (paper presets: {n_signals * T})"
             title = f"N = {n_signals}, T = {T}, Z = {z}, {args.trials} trial(s)"
             sections[title] = markdown_table(results, COLUMNS, PAPER.get(n_signals))
     write_markdown(
