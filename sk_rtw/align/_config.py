@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass
-from typing import Any
+from typing import Any, Literal, overload
 
 import numpy as np
 import torch
@@ -213,6 +213,14 @@ def check_preset(preset: Any) -> str:
     if not isinstance(preset, str) or preset.lower() not in PRESETS:
         raise ValueError(f"preset must be one of {PRESETS} or None, got {preset!r}")
     return preset.lower()
+
+
+@overload
+def check_int(name: str, value: Any, minimum: int, allow_none: Literal[False] = ...) -> int: ...
+
+
+@overload
+def check_int(name: str, value: Any, minimum: int, allow_none: Literal[True]) -> int | None: ...
 
 
 def check_int(name: str, value: Any, minimum: int, allow_none: bool = False) -> int | None:

@@ -18,7 +18,7 @@ from ._loss import monotonicity_penalty, window_loss, window_weights
 from ._sinc import TABLE_BYTES, SincInterpolator
 from ._start import dtw_start
 from ._training import Trainer, progress_printer
-from ._warps import NeuralWarps, SineWarps, compose_warps, unit_time
+from ._warps import NeuralWarps, SineWarps, WarpModel, compose_warps, unit_time
 
 
 @dataclass(frozen=True, eq=False)
@@ -53,7 +53,7 @@ class Alignment:
     fit_time: float = field(default=0.0)
 
 
-def _build_warps(config: AlignmentConfig, n_signals: int) -> torch.nn.Module:
+def _build_warps(config: AlignmentConfig, n_signals: int) -> NeuralWarps | SineWarps:
     if config.warp == "sine":
         return SineWarps(n_signals, config.n_components)
     return NeuralWarps(n_signals, config.hidden_size, config.init, config.warp_knots)
@@ -83,7 +83,7 @@ class _Problem:
         #: Starting warps (N, Z) that the learned warps are composed with, or None.
         self.start: torch.Tensor | None = None
 
-    def forward(self, model: torch.nn.Module):
+    def forward(self, model: WarpModel):
         raw = model(self.zhat)
         warps = model.finalise(raw)
         if self.start is not None:
@@ -238,7 +238,8 @@ def align(
         )
     with torch.random.fork_rng(devices=[]):
         torch.manual_seed(seed)
-        model = _build_warps(config, n_signals).to(config.device)
+        model = _build_warps(config, n_signals)
+        model.to(config.device)
     problem = _Problem(collection, config)
     if config.warp_start == "dtw" and n_signals > 1:
         given_start = dtw_start(
@@ -328,7 +329,7 @@ def _check_warps(warps: Any, n_signals: int, output_length: int | None) -> np.nd
 
 
 def _optimise(
-    problem: _Problem, model: torch.nn.Module, history: np.ndarray, verbose: bool | int
+    problem: _Problem, model: WarpModel, history: np.ndarray, verbose: bool | int
 ) -> int:
     """Adam over the warp parameters; loads the best iterate into ``model``."""
     config = problem.config

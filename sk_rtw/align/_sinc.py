@@ -190,6 +190,8 @@ class SincInterpolator:
             return self.table[self._rows, base]
         if self.manifold.is_flat:
             return None if self.window is None else self._window_samples(base)
+        if anchors is None:
+            raise ValueError("curved manifolds need tangent points")
         return self._logs(anchors, self._window_samples(base))
 
     def _chunks(self, n_points: int):

@@ -27,6 +27,8 @@ most of an epoch's work on a CPU; ``None`` evaluates it at every output time (th
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
+from typing import Protocol, runtime_checkable
 
 import torch
 from torch import nn
@@ -35,6 +37,27 @@ from torch import nn
 #: hidden layers with a zero readout (the warps start exactly at the identity while the
 #: hidden units differ, so the network is not confined to a linear function as with zeros).
 INITS = ("xavier", "zeros", "zero-readout")
+
+
+@runtime_checkable
+class WarpModel(Protocol):
+    """What the engine needs of a warp model (:class:`NeuralWarps`, :class:`SineWarps`).
+
+    A new family of warps is a ``torch.nn.Module`` with these three members; the engine
+    trains its parameters with Adam against the method's loss.
+    """
+
+    def __call__(self, zhat: torch.Tensor) -> torch.Tensor:
+        """Raw warps (N, Z) at the unit times ``zhat`` (Z,); the penalty reads them."""
+        ...
+
+    def finalise(self, raw: torch.Tensor) -> torch.Tensor:
+        """Warps in [0, 1] (N, Z), non-decreasing where the family guarantees it."""
+        ...
+
+    def parameters(self, recurse: bool = True) -> Iterator[nn.Parameter]:
+        """The trainable parameters."""
+        ...
 
 
 def unit_time(n_points: int, dtype=torch.float64, device=None) -> torch.Tensor:
@@ -54,6 +77,7 @@ class HouseholderBasis(nn.Module):
         u = torch.full((n_signals,), -1.0 / math.sqrt(n_signals), dtype=dtype)
         u[0] += 1.0
         norm_sq = float(u @ u)
+        self.u: torch.Tensor
         self.register_buffer("u", u)
         self.scale = 2.0 / norm_sq if norm_sq > 0 else 0.0
 
@@ -168,6 +192,8 @@ class NeuralWarps(nn.Module):
 
     def offsets(self, zhat: torch.Tensor) -> torch.Tensor:
         """``sum_k phi_theta(zhat)_k e_{k+1}``, shape (Z, N)."""
+        if self.phi is None:
+            raise RuntimeError("one signal has no warp offsets")
         if self.knots is None or self.knots >= zhat.shape[0]:
             return self.basis.combine(self.phi(zhat))
         grid = unit_time(self.knots, dtype=zhat.dtype, device=zhat.device)

@@ -78,7 +78,7 @@ def dba_average(
     w = _check_window(window)
     series = [collection.series(i) for i in range(collection.n_series)]
     mean = _initial_mean(collection, init, window, squared)
-    best = None
+    best: tuple[float, np.ndarray, tuple[np.ndarray, ...]] | None = None
     previous = np.inf
     for iteration in range(n_iter + 1):
         paths, costs = zip(*(path_indices(mean, s, M, w, squared) for s in series), strict=True)
@@ -94,6 +94,7 @@ def dba_average(
         points = np.concatenate([s[p[:, 1]] for s, p in zip(series, paths, strict=True)])
         # Gauss–Newton from the previous average: it is close, so a few steps suffice.
         mean = grouped_mean(M, groups, points, len(mean), start=mean, max_iter=MEAN_STEPS, tol=0.0)
+    assert best is not None  # the loop runs at least once
     cost, mean, paths = best
     first = [np.searchsorted(p[:, 0], np.arange(len(mean))) for p in paths]
     indices = np.stack([p[f, 1] for p, f in zip(paths, first, strict=True)])

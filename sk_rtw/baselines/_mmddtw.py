@@ -144,7 +144,8 @@ def mmddtw_align(
         if not isinstance(M, SPD):
             raise ValueError(f"metric='cholesky' needs SPD matrices, got {M!r}")
         factors = [np.linalg.cholesky(s) for s in series]
-        points, space = [f.reshape(len(f), -1) for f in factors], Euclidean(M.dim * M.dim)
+        space: Manifold = Euclidean(M.dim * M.dim)
+        points = [f.reshape(len(f), -1) for f in factors]
     else:
         points, space = series, M
 

@@ -161,8 +161,9 @@ def make_warped_signals(
         original = np.asarray(original, dtype=np.float64)
         manifold.validate(original, name="original")
         length = len(original)
-    warps, chosen = [], []
-    while len(warps) < n_signals:
+    drawn: list[np.ndarray] = []
+    chosen: list[str] = []
+    while len(drawn) < n_signals:
         family = families[int(rng.integers(len(families)))]
         for _ in range(1000):
             warp = random_warp(family, length, rng, strength)
@@ -170,9 +171,9 @@ def make_warped_signals(
                 break
         else:
             raise RuntimeError(f"could not draw a valid {family!r} warp; lower strength")
-        warps.append(warp)
+        drawn.append(warp)
         chosen.append(family)
-    warps = np.stack(warps)
+    warps = np.stack(drawn)
     data = torch.from_numpy(np.ascontiguousarray(original))[None]
     lengths = torch.tensor([length])
     with torch.no_grad():

@@ -76,10 +76,10 @@ def _flat(x: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(x.reshape(x.shape[0], -1))
 
 
-def _pair(x, y, manifold):
-    x, manifold = check_series(x, manifold, name="x", min_length=1)
-    y, _ = check_series(y, manifold, name="y", min_length=1)
-    return x, y, manifold
+def _pair(x, y, manifold) -> tuple[np.ndarray, np.ndarray, Manifold]:
+    x, checked = check_series(x, manifold, name="x", min_length=1)
+    y, _ = check_series(y, checked, name="y", min_length=1)
+    return x, y, checked
 
 
 def dtw_cost_matrix(
@@ -237,9 +237,9 @@ def _pairwise(
     cx: SeriesCollection, cy: SeriesCollection, window, squared, symmetric, per_step
 ) -> np.ndarray:
     manifold = cx.manifold
-    segments = manifold.numba_segments
-    if segments is not None:
-        segments = np.asarray(segments, dtype=np.int64)
+    segments = None
+    if manifold.numba_segments is not None:
+        segments = np.asarray(manifold.numba_segments, dtype=np.int64)
         flat_x = np.ascontiguousarray(cx.data.reshape(cx.n_series, cx.max_length, -1))
         flat_y = np.ascontiguousarray(cy.data.reshape(cy.n_series, cy.max_length, -1))
         if not per_step:

@@ -15,9 +15,9 @@ from sklearn.utils.validation import check_is_fitted
 
 from .._numba import check_n_jobs
 from .._random import check_random_state_value
-from ..align import METHODS, align, classification_output_length
+from ..align import METHODS, Alignment, align, classification_output_length
 from ..align._config import check_preset
-from ..baselines import dba_average
+from ..baselines import MultipleAlignment, dba_average
 from ..dtw import dtw_pairwise_distance
 from ..dtw._dtw import _check_window as check_window
 from ..manifolds import Manifold
@@ -235,7 +235,7 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         return self
 
     def _engine_options(self) -> dict[str, Any]:
-        options = {
+        options: dict[str, Any] = {
             "n_components": self.n_components,
             "hidden_size": self.hidden_size,
             "mean_iterations": self.mean_iterations,
@@ -250,6 +250,7 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         self, collection: SeriesCollection, method: str, output_length: int, seed: int, label
     ):
         start = time.perf_counter()
+        result: MultipleAlignment | Alignment
         if method == "dba":
             result = dba_average(collection, window=self.dtw_window)
             detail = f"cost {result.cost:.4g}"

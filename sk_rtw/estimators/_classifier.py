@@ -44,7 +44,7 @@ mean_iterations, dtw_window, n_jobs, random_state, device, verbose
     ['sin', 'sin', 'cos', 'cos']
     """
 
-    def fit(self, X: Any, y: Any):
+    def fit(self, X: Any, y: Any = None):
         """Learn one mean per class.
 
         Parameters

@@ -43,6 +43,13 @@ def _fixed(size):
     return lambda shape: 0 if shape == (size,) else None
 
 
+def _given(dim: int | None) -> int:
+    """The dimension a spec's ``infer`` found (always set by the time a factory runs)."""
+    if dim is None:
+        raise ValueError("the manifold's dimension could not be inferred")
+    return dim
+
+
 def _pose(_dim=None) -> Product:
     return Product((Euclidean(3), Quaternion()))
 
@@ -52,12 +59,14 @@ _REGISTRY: dict[str, ManifoldSpec] = {
     for spec in [
         ManifoldSpec(
             "euclidean",
-            lambda d: Euclidean(d),
+            lambda d: Euclidean(_given(d)),
             _euclidean_dim,
             "R^d; univariate series are R^1",
             flat=True,
         ),
-        ManifoldSpec("sphere", lambda d: Sphere(d), _sphere_dim, "unit sphere S^d in R^(d+1)"),
+        ManifoldSpec(
+            "sphere", lambda d: Sphere(_given(d)), _sphere_dim, "unit sphere S^d in R^(d+1)"
+        ),
         ManifoldSpec(
             "quaternion",
             lambda d: Quaternion(),
@@ -67,7 +76,7 @@ _REGISTRY: dict[str, ManifoldSpec] = {
         ),
         ManifoldSpec(
             "spd",
-            lambda d: SPD(d),
+            lambda d: SPD(_given(d)),
             _spd_dim,
             "SPD(k) matrices, affine-invariant metric",
             matrix_valued=True,
