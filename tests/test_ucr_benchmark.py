@@ -42,16 +42,51 @@ def test_small_run_writes_results_resumes_and_records_failures(tmp_path, capsys)
         assert len(entry["predictions"]) == record["n_test"] == 1029
     assert len(record["methods"]["rtw"]["alignment"]) == 12
     assert set(record["tests"]) >= {"rtw|ttw", "rtw|dba"}
-    failed = json.loads((out / "datasets" / "NoSuchDataset.json").read_text())
-    assert failed["error"]
+    assert not (out / "datasets" / "NoSuchDataset.json").exists()  # never tried to download
+    captured = capsys.readouterr()
+    assert "'NoSuchDataset' is not available offline" in captured.err
+    assert "RTW against dba:" in captured.out  # the verdict
     summary = (out / "summary.md").read_text()
-    assert "Table II" in summary and "ItalyPowerDemand" in summary
+    assert "Table II" in summary and "ItalyPowerDemand" in summary and "## Verdict" in summary
     assert (out / "accuracy_scatter.png").stat().st_size > 0
+    for path in (out / "summary.md", out / "datasets" / "ItalyPowerDemand.json"):
+        assert path.stat().st_mode & 0o777 == 0o644  # readable result files
     mtime = (out / "datasets" / "ItalyPowerDemand.json").stat().st_mtime_ns
     capsys.readouterr()
     main([*args, "--resume"])
     assert (out / "datasets" / "ItalyPowerDemand.json").stat().st_mtime_ns == mtime
     assert "1 already done" in capsys.readouterr().err
+
+
+def test_a_run_with_no_available_dataset_fails_clearly(tmp_path, capsys):
+    assert main(["--datasets", "NoSuchDataset", "--out", str(tmp_path), "--quiet"]) == 1
+    err = capsys.readouterr().err
+    assert "none of the requested datasets is available offline" in err
+    assert "nothing is downloaded" in err
+
+
+def test_failing_datasets_are_recorded_and_make_the_run_fail(tmp_path, monkeypatch, capsys):
+    import benchmarks.ucr._protocol as protocol
+
+    def broken(*args, **kwargs):
+        raise OSError("disk on fire")
+
+    monkeypatch.setattr(protocol, "load_split", broken)
+    args = ["--datasets", "ItalyPowerDemand", "--methods", "dba", "--out", str(tmp_path)]
+    assert main([*args, "--quiet"]) == 1
+    record = json.loads((tmp_path / "datasets" / "ItalyPowerDemand.json").read_text())
+    assert "disk on fire" in record["error"]
+    assert "every dataset failed" in capsys.readouterr().err
+
+
+def test_help_lists_every_option_with_examples(capsys):
+    with pytest.raises(SystemExit):
+        main(["--help"])
+    text = capsys.readouterr().out
+    for option in ("--data-dir", "--methods", "--epochs", "--jobs", "--resume", "--verbose"):
+        assert option in text
+    assert "python benchmarks/ucr/run.py --data-dir ../shared/ucr" in text
+    assert "nothing is downloaded" in text.lower()
 
 
 def test_paired_test_decisions():

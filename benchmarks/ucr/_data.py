@@ -1,9 +1,12 @@
 """Loading UCR datasets through aeon and converting them to sk_rtw's time-major layout.
 
 aeon returns channels-first data: an array ``(n_cases, n_channels, n_timepoints)`` or, for
-unequal-length datasets, a list of ``(n_channels, T_i)`` arrays. Here (and only here) it
-becomes ``(n_cases, T)`` for univariate data, ``(n_cases, T, n_channels)`` otherwise, or a
-list of ``(T_i,)`` / ``(T_i, n_channels)`` series.
+unequal-length datasets, a list of ``(n_channels, T_i)`` arrays. :func:`sk_rtw.utils.from_aeon`
+turns it into ``(n_cases, T)`` for univariate data, ``(n_cases, T, n_channels)`` otherwise,
+or a list of ``(T_i,)`` / ``(T_i, n_channels)`` series.
+
+Nothing is downloaded: a dataset is available when it is in the data directory (aeon's
+local layout) or bundled with aeon; :func:`check_available` says which are not.
 
 Missing values (NaN) are filled by linear interpolation along time, the ends by the
 nearest observed value; a series with no observed value is dropped (and reported).
@@ -16,6 +19,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+
+from sk_rtw.utils import from_aeon
 
 #: Datasets that aeon ships inside its package (usable with no data directory).
 AEON_BUNDLED = ("ArrowHead", "GunPoint", "ItalyPowerDemand")
@@ -45,6 +50,34 @@ def available_datasets(data_dir: str | None) -> list[str]:
     return sorted(names)
 
 
+class DatasetUnavailable(LookupError):
+    """A dataset that is neither in the data directory nor bundled with aeon."""
+
+
+def aeon_shipped(name: str) -> bool:
+    """Whether aeon's package holds the classification dataset ``name`` (any of its own)."""
+    try:
+        import aeon.datasets
+    except ImportError:
+        return False
+    folder = Path(aeon.datasets.__file__).parent / "data" / name
+    return (folder / f"{name}_TRAIN.ts").is_file()
+
+
+def check_available(name: str, data_dir: str | None) -> None:
+    """Raise :class:`DatasetUnavailable` (with what to do) unless ``name`` can be loaded."""
+    if name in AEON_BUNDLED or aeon_shipped(name):
+        return
+    if data_dir and (Path(data_dir) / name / f"{name}_TRAIN.ts").is_file():
+        return
+    where = f"in {data_dir}" if data_dir else f"(no --data-dir given, ${ENV_DATA_DIR} unset)"
+    raise DatasetUnavailable(
+        f"dataset {name!r} is not available offline {where}: put it there in aeon's local "
+        f"layout ({name}/{name}_TRAIN.ts and _TEST.ts) or choose from "
+        f"{', '.join(available_datasets(data_dir))}; nothing is downloaded"
+    )
+
+
 def _fill_missing(series: np.ndarray) -> np.ndarray | None:
     """Interpolate NaNs along time (axis 0); None if a channel has no observed value."""
     series = np.array(series, dtype=np.float64)
@@ -62,14 +95,12 @@ def _fill_missing(series: np.ndarray) -> np.ndarray | None:
 def load_split(name: str, split: str, data_dir: str | None) -> Split:
     from aeon.datasets import load_classification
 
+    check_available(name, data_dir)
     path = data_dir if data_dir and (Path(data_dir) / name).is_dir() else None
     X, y = load_classification(name, split=split, extract_path=path)
-    cases = list(X)  # (channels, T) arrays, equal lengths or not
     series, labels, notes = [], [], []
     n_filled = 0
-    for i, case in enumerate(cases):
-        case = np.asarray(case, dtype=np.float64)  # (channels, T)
-        s = case[0] if case.shape[0] == 1 else case.T
+    for i, s in enumerate(from_aeon(list(X))):  # (T,) or (T, channels) each
         if np.isnan(s).any():
             s = _fill_missing(s)
             if s is None:

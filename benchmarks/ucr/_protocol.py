@@ -30,6 +30,8 @@ import sys
 import tempfile
 import time
 import traceback
+import warnings
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -37,10 +39,13 @@ import numpy as np
 from scipy import stats
 
 from sk_rtw import RTWNearestCentroid, dtw_pairwise_distance
+from sk_rtw.utils import to_aeon
 
 from ._data import load_split, subsample_per_class, take
 
 ALPHA = 0.05
+#: Result files are readable by everyone (rw-r--r--), like any file the user writes.
+FILE_MODE = 0o644
 #: Rows computed by the product's estimator, with its parameters.
 ESTIMATOR_METHODS = {
     "rtw": {"method": "rtw"},
@@ -75,6 +80,7 @@ def atomic_write_json(path: Path, payload: dict) -> None:
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     with os.fdopen(fd, "w") as handle:
         json.dump(payload, handle, indent=1, default=_jsonable)
+    os.chmod(tmp, FILE_MODE)  # mkstemp creates 0600
     os.replace(tmp, path)
 
 
@@ -84,13 +90,6 @@ def _jsonable(value):
     if isinstance(value, np.ndarray):
         return value.tolist()
     return str(value)
-
-
-def _aeon_format(X):
-    """(n, T) or (n, T, C) or list -> aeon's channels-first layout."""
-    if isinstance(X, np.ndarray):
-        return X[:, None, :] if X.ndim == 2 else np.swapaxes(X, 1, 2)
-    return [s[None, :] if s.ndim == 1 else s.T for s in X]
 
 
 def _class_members(y, classes):
@@ -104,7 +103,7 @@ def _fit_estimator(method, train, test, config):
         output_length=config.output_length,
         random_state=config.seed,
         device=config.device,
-        verbose=config.verbose,
+        verbose=max(0, config.verbose - 1),  # 2: a line per class, 3: epoch progress
     )
     start = time.perf_counter()
     estimator.fit(train.X, train.y)
@@ -145,7 +144,7 @@ def _fit_aeon_dba(train, test, config):
     means = np.stack(
         [
             elastic_barycenter_average(
-                _aeon_format(train.X[members]), distance="dtw", random_state=config.seed
+                to_aeon(train.X[members]), distance="dtw", random_state=config.seed
             )[0]
             for members in _class_members(train.y, classes)
         ]
@@ -171,10 +170,10 @@ def _fit_1nn(train, test, config):
 
     classifier = KNeighborsTimeSeriesClassifier(distance="dtw", n_neighbors=1)
     start = time.perf_counter()
-    classifier.fit(_aeon_format(train.X), train.y)
+    classifier.fit(to_aeon(train.X), train.y)
     fit_seconds = time.perf_counter() - start
     start = time.perf_counter()
-    predictions = classifier.predict(_aeon_format(test.X))
+    predictions = classifier.predict(to_aeon(test.X))
     return {
         "fit_seconds": fit_seconds,
         "predict_seconds": time.perf_counter() - start,
@@ -213,8 +212,32 @@ def pairwise_tests(results: dict) -> dict:
     return tests
 
 
-def process_dataset(name: str, config: RunConfig, position: str = "") -> dict:
-    """Run every method on one dataset and write ``<out>/datasets/<name>.json``."""
+def process_dataset(
+    name: str,
+    config: RunConfig,
+    position: str = "",
+    on_method_done: Callable[[str], None] | None = None,
+) -> dict:
+    """Run every method on one dataset and write ``<out>/datasets/<name>.json``.
+
+    ``on_method_done(method)`` is called after each method (progress bars).
+    """
+    with warnings.catch_warnings():
+        _quiet_third_party_warnings()
+        return _process_dataset(name, config, position, on_method_done or (lambda m: None))
+
+
+def _quiet_third_party_warnings() -> None:
+    """aeon's numba kernels warn about reflected lists on every call: not ours to act on."""
+    try:
+        from numba.core.errors import NumbaPendingDeprecationWarning, NumbaTypeSafetyWarning
+    except ImportError:  # pragma: no cover
+        return
+    warnings.simplefilter("ignore", NumbaTypeSafetyWarning)
+    warnings.simplefilter("ignore", NumbaPendingDeprecationWarning)
+
+
+def _process_dataset(name, config, position, on_method_done) -> dict:
     start = time.perf_counter()
     record = {"dataset": name, "config": asdict(config), "methods": {}, "error": None}
     path = Path(config.out) / "datasets" / f"{name}.json"
@@ -238,6 +261,7 @@ def process_dataset(name: str, config: RunConfig, position: str = "") -> dict:
                 record["methods"][method] = {
                     "skipped": f"time budget of {config.time_budget:.0f} s used up"
                 }
+                on_method_done(method)
                 continue
             _log(config, f"{position} {name}: {method} ...")
             try:
@@ -252,6 +276,7 @@ def process_dataset(name: str, config: RunConfig, position: str = "") -> dict:
             except Exception as exc:  # one method failing must not lose the others
                 record["methods"][method] = {"error": f"{type(exc).__name__}: {exc}"}
                 _log(config, f"{position} {name}: {method} failed: {exc}")
+                on_method_done(method)
                 continue
             correct = (np.asarray(out["predictions"]) == test.y).astype(int)
             out["correct"] = correct
@@ -262,6 +287,7 @@ def process_dataset(name: str, config: RunConfig, position: str = "") -> dict:
                 f"{position} {name}: {method} accuracy {out['accuracy']:.3f} "
                 f"({out['fit_seconds']:.1f} s)",
             )
+            on_method_done(method)
         record["tests"] = pairwise_tests(record["methods"])
         record["test_labels"] = test.y
     except Exception as exc:
@@ -275,4 +301,9 @@ def process_dataset(name: str, config: RunConfig, position: str = "") -> dict:
 
 def _log(config: RunConfig, text: str) -> None:
     if config.verbose:
-        print(text, file=sys.stderr, flush=True)
+        try:  # above an active progress bar, not through it
+            from tqdm import tqdm
+
+            tqdm.write(text, file=sys.stderr)
+        except ImportError:
+            print(text, file=sys.stderr, flush=True)

@@ -9,9 +9,15 @@ datasets in the layout of the paper's Table II, with a scatter plot like its Fig
 Examples::
 
     python benchmarks/ucr/run.py                       # aeon's bundled datasets, offline
-    python benchmarks/ucr/run.py --data-dir ../shared/ucr --all --epochs 64 --resume
-    python benchmarks/ucr/run.py --datasets CBF GunPoint --methods rtw ttw
+    python benchmarks/ucr/run.py --data-dir ../shared/ucr --all --jobs 2 --resume
+    python benchmarks/ucr/run.py --data-dir ../shared/ucr --datasets CBF Coffee --methods rtw dba
+    python benchmarks/ucr/run.py --methods rtw rtw-paper dba --epochs 64 -v
     python benchmarks/ucr/run.py --all --jobs 8 --backend dask --scheduler tcp://host:8786
+
+Nothing is downloaded: a dataset must be in --data-dir (aeon's local layout,
+<dir>/<name>/<name>_TRAIN.ts) or bundled with aeon (ArrowHead, GunPoint,
+ItalyPowerDemand). Unavailable datasets are reported and skipped; the exit status is 1
+when no dataset could be run, 0 otherwise.
 
 Results (``--out``, default ``results/ucr``)::
 
@@ -20,7 +26,8 @@ Results (``--out``, default ``results/ucr``)::
                             series averaging values, per-test-series predictions and
                             distances, paired t-tests, errors
     summary.md              the tables printed at the end
-    accuracy_scatter.png    RTW against TTW/NTW accuracy per dataset
+    accuracy_scatter.png    RTW against TTW/NTW/DBA accuracy per dataset
+    critical_difference.png aeon's critical-difference diagram of the accuracies
 
 ``--resume`` skips datasets whose file exists without an error, so an interrupted run
 loses at most the datasets in progress. A dataset (or a method) that fails is recorded
@@ -44,7 +51,9 @@ if str(ROOT) not in sys.path:
 from benchmarks.ucr._data import (  # noqa: E402
     AEON_BUNDLED,
     ENV_DATA_DIR,
+    DatasetUnavailable,
     available_datasets,
+    check_available,
     default_data_dir,
 )
 from benchmarks.ucr._protocol import (  # noqa: E402
@@ -53,7 +62,13 @@ from benchmarks.ucr._protocol import (  # noqa: E402
     RunConfig,
     process_dataset,
 )
-from benchmarks.ucr._summary import load_records, markdown, scatter_plot  # noqa: E402
+from benchmarks.ucr._summary import (  # noqa: E402
+    critical_difference_plot,
+    load_records,
+    markdown,
+    scatter_plot,
+    verdict,
+)
 
 
 def parse_args(argv=None) -> argparse.Namespace:
@@ -69,7 +84,12 @@ def parse_args(argv=None) -> argparse.Namespace:
         "aeon's own location with its bundled datasets)",
     )
     which = parser.add_mutually_exclusive_group()
-    which.add_argument("--datasets", nargs="+", metavar="NAME")
+    which.add_argument(
+        "--datasets",
+        nargs="+",
+        metavar="NAME",
+        help=f"datasets to run (default: aeon's bundled {', '.join(AEON_BUNDLED)})",
+    )
     which.add_argument(
         "--all", action="store_true", help="every dataset in --data-dir plus aeon's bundled ones"
     )
@@ -80,7 +100,9 @@ def parse_args(argv=None) -> argparse.Namespace:
         choices=list(ALL_METHODS),
         help="rows to compute (default: all but rtw-paper, which is slow)",
     )
-    parser.add_argument("--epochs", type=int, default=256)
+    parser.add_argument(
+        "--epochs", type=int, default=256, help="training epochs of RTW, TTW, NTW (default 256)"
+    )
     parser.add_argument(
         "--max-series-per-class",
         type=int,
@@ -94,8 +116,10 @@ def parse_args(argv=None) -> argparse.Namespace:
         default=None,
         help="length Z of the means (default: min(N, 4) T)",
     )
-    parser.add_argument("--device", default="cpu")
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--device", default="cpu", help="torch device: cpu (default), cuda, ...")
+    parser.add_argument(
+        "--seed", type=int, default=0, help="random_state of every method and of subsampling"
+    )
     parser.add_argument("--jobs", type=int, default=1, help="datasets in parallel")
     parser.add_argument(
         "--backend",
@@ -111,9 +135,25 @@ def parse_args(argv=None) -> argparse.Namespace:
         default=None,
         help="seconds per dataset; methods not started by then are skipped",
     )
-    parser.add_argument("--out", default="results/ucr")
-    parser.add_argument("--resume", action="store_true")
-    parser.add_argument("--quiet", action="store_true")
+    parser.add_argument(
+        "--out", default="results/ucr", help="results directory (default results/ucr)"
+    )
+    parser.add_argument(
+        "--resume",
+        action="store_true",
+        help="skip datasets whose result file in --out exists without an error",
+    )
+    loud = parser.add_mutually_exclusive_group()
+    loud.add_argument(
+        "--quiet", action="store_true", help="no progress bar and no per-method lines"
+    )
+    loud.add_argument(
+        "-v",
+        "--verbose",
+        action="count",
+        default=0,
+        help="-v: a line per class fit; -vv: epoch progress inside each fit",
+    )
     return parser.parse_args(argv)
 
 
@@ -137,10 +177,43 @@ def finished(out: Path, name: str) -> bool:
         return False
 
 
-def run_all(names: list[str], config: RunConfig, jobs: int, backend: str, scheduler):
+def progress_bar(n_datasets: int, n_methods: int, enabled: bool):
+    """A tqdm bar over dataset x method fits with a time estimate (None without tqdm)."""
+    if not enabled:
+        return None
+    try:
+        from tqdm import tqdm
+    except ImportError:
+        return None
+    return tqdm(
+        total=n_datasets * n_methods,
+        unit="fit",
+        desc="datasets x methods",
+        file=sys.stderr,
+        dynamic_ncols=True,
+    )
+
+
+def run_all(names: list[str], config: RunConfig, jobs: int, backend: str, scheduler, bar=None):
     from joblib import Parallel, delayed, parallel_config
 
     total = len(names)
+    n_methods = len(config.methods)
+
+    def advance(record: dict) -> dict:
+        if bar is not None:
+            bar.update(n_methods)
+            bar.set_postfix_str(record["dataset"], refresh=False)
+        return record
+
+    if jobs == 1 and backend != "dask":  # method-level progress in this process
+        records = []
+        for i, name in enumerate(names):
+            if bar is not None:
+                bar.set_postfix_str(name)
+            tick = (lambda method: bar.update(1)) if bar is not None else None
+            records.append(process_dataset(name, config, f"[{i + 1:>3}/{total}]", tick))
+        return records
     tasks = [
         delayed(process_dataset)(name, config, f"[{i + 1:>3}/{total}]")
         for i, name in enumerate(names)
@@ -158,17 +231,29 @@ def run_all(names: list[str], config: RunConfig, jobs: int, backend: str, schedu
         )
         print(f"dask: {client}", file=sys.stderr)
         with client, parallel_config(backend="dask"):
-            return Parallel(verbose=0)(tasks)
-    if jobs == 1:
-        return [task[0](*task[1], **task[2]) for task in tasks]
+            return [advance(r) for r in Parallel(return_as="generator_unordered")(tasks)]
     with parallel_config(backend=backend, n_jobs=jobs):
-        return Parallel()(tasks)
+        return [advance(r) for r in Parallel(return_as="generator_unordered")(tasks)]
 
 
 def main(argv=None) -> int:
     args = parse_args(argv)
     out = Path(args.out)
-    names = select_datasets(args)
+    names, unavailable = [], []
+    for name in select_datasets(args):
+        try:
+            check_available(name, args.data_dir)
+            names.append(name)
+        except DatasetUnavailable as exc:
+            unavailable.append(name)
+            print(f"skipped: {exc}", file=sys.stderr)
+    if not names:
+        print(
+            f"error: none of the requested datasets is available offline "
+            f"({', '.join(unavailable)}); nothing was run",
+            file=sys.stderr,
+        )
+        return 1
     todo = [n for n in names if not (args.resume and finished(out, n))]
     config = RunConfig(
         methods=tuple(args.methods),
@@ -180,7 +265,7 @@ def main(argv=None) -> int:
         seed=args.seed,
         time_budget=args.time_budget,
         out=str(out),
-        verbose=0 if args.quiet else 1,
+        verbose=0 if args.quiet else 1 + args.verbose,
     )
     print(
         f"{len(names)} dataset(s), {len(names) - len(todo)} already done; methods "
@@ -188,7 +273,12 @@ def main(argv=None) -> int:
         file=sys.stderr,
     )
     start = time.perf_counter()
-    run_all(todo, config, args.jobs, args.backend, args.scheduler)
+    bar = progress_bar(len(todo), len(args.methods), enabled=not args.quiet)
+    try:
+        run_all(todo, config, args.jobs, args.backend, args.scheduler, bar)
+    finally:
+        if bar is not None:
+            bar.close()
     records = [r for r in load_records(out) if r["dataset"] in names]
     command = "python benchmarks/ucr/run.py " + " ".join(
         shlex.quote(a) for a in (argv if argv is not None else sys.argv[1:])
@@ -200,12 +290,21 @@ def main(argv=None) -> int:
     )
     text = markdown(records, list(args.methods), command.strip(), machine)
     (out / "summary.md").write_text(text)
-    plotted = scatter_plot(records, out / "accuracy_scatter.png")
+    written = [out / "summary.md"]
+    if scatter_plot(records, out / "accuracy_scatter.png"):
+        written.append(out / "accuracy_scatter.png")
+    if critical_difference_plot(records, list(args.methods), out / "critical_difference.png"):
+        written.append(out / "critical_difference.png")
+    for path in written:
+        path.chmod(0o644)
     print(text)
-    print(
-        f"written: {out / 'summary.md'}"
-        + (f", {out / 'accuracy_scatter.png'}" if plotted else " (no matplotlib: no plot)")
-    )
+    print("written: " + ", ".join(str(p) for p in written))
+    print("\n".join(verdict(records, list(args.methods))))
+    if unavailable:
+        print(f"not available offline (skipped): {', '.join(unavailable)}")
+    if all(r.get("error") for r in records):
+        print("error: every dataset failed (see the result files)", file=sys.stderr)
+        return 1
     return 0
 
 
