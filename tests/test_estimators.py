@@ -6,6 +6,7 @@ import pickle
 
 import numpy as np
 import pytest
+from scipy.special import softmax
 from sklearn.base import clone
 from sklearn.exceptions import NotFittedError
 from sklearn.model_selection import GridSearchCV, cross_val_score
@@ -292,3 +293,63 @@ def test_bad_method_and_preset_are_named():
         RTWNearestCentroid(method="kmeans").fit(X, y)
     with pytest.raises(ValueError, match="preset"):
         RTWNearestCentroid(preset="fast").fit(X, y)
+
+
+# ---------------------------------------------------------------- probabilities
+
+
+def test_fit_temperature_minimises_the_log_loss_like_a_grid_search(rng):
+    from scipy.special import log_softmax
+
+    from sk_rtw.estimators._classifier import fit_temperature
+
+    labels = rng.integers(0, 3, 200)
+    distances = rng.gamma(4.0, 10.0, (200, 3))
+    distances[np.arange(200), labels] *= 0.7  # own class nearer, with overlap
+
+    def loss(tau):
+        return -log_softmax(-distances / tau, axis=1)[np.arange(200), labels].mean()
+
+    grid = np.exp(np.linspace(-3, 6, 4001))
+    best_on_grid = grid[np.argmin([loss(t) for t in grid])]
+    tau = fit_temperature(distances, labels)
+    assert tau == pytest.approx(best_on_grid, rel=0.01)
+    assert loss(tau) <= loss(best_on_grid) + 1e-9
+
+
+def test_probabilities_are_calibrated_not_saturated():
+    from sklearn.metrics import log_loss
+
+    from sk_rtw.datasets import make_warped_signals
+
+    rng = np.random.default_rng(0)
+    a = np.asarray(make_warped_signals("euclidean", 30, 40, random_state=1).signals)[..., 0]
+    b = a[:, ::-1] + 0.0  # the same shapes reversed in time: separable but noisy below
+    X = np.concatenate([a, b]) * 10.0 + rng.normal(0, 6.0, (60, 40))
+    y = np.repeat([0, 1], 30)
+    clf = RTWNearestCentroid(method="dba", random_state=0).fit(X[::2], y[::2])
+    raw = RTWNearestCentroid(method="dba", random_state=0, temperature=1.0).fit(X[::2], y[::2])
+    proba = clf.predict_proba(X[1::2])
+    assert clf.temperature_ > 1.0  # distances of ~100s: a unit scale saturates
+    saturated = (proba.max(1) > 0.999).mean()
+    assert saturated < 0.5 < (raw.predict_proba(X[1::2]).max(1) > 0.999).mean()
+    assert np.array_equal(clf.predict(X[1::2]), raw.predict(X[1::2]))  # same decisions
+    assert log_loss(y[1::2], proba) < log_loss(y[1::2], raw.predict_proba(X[1::2]))
+    assert log_loss(y[1::2], proba) < np.log(2)  # better than knowing nothing
+
+
+def test_a_given_temperature_is_used_as_is():
+    X = np.stack([np.sin(np.linspace(0, 3, 20) + s) for s in (0.0, 0.1, 2.0, 2.1)])
+    y = [0, 0, 1, 1]
+    clf = RTWNearestCentroid(method="dba", temperature=2.5).fit(X, y)
+    assert clf.temperature_ == 2.5
+    expected = softmax(-clf.transform(X) / 2.5, axis=1)
+    np.testing.assert_allclose(clf.predict_proba(X), expected)
+    assert "temperature" in TTWNearestCentroid().get_params()
+
+
+@pytest.mark.parametrize("bad", [0, -1.0, np.nan, "hot", True])
+def test_bad_temperatures_are_rejected(bad):
+    X = np.stack([np.sin(np.linspace(0, 3, 20) + s) for s in (0.0, 0.1, 2.0, 2.1)])
+    with pytest.raises(ValueError, match="temperature"):
+        RTWNearestCentroid(method="dba", temperature=bad).fit(X, [0, 0, 1, 1])

@@ -2,14 +2,51 @@
 
 from __future__ import annotations
 
+import inspect
+import math
 from typing import Any
 
 import numpy as np
-from scipy.special import softmax
+from scipy.optimize import minimize_scalar
+from scipy.special import log_softmax, softmax
 from sklearn.base import ClassifierMixin
 from sklearn.utils.validation import check_is_fitted
 
-from ._averager import RTWAverager
+from ..manifolds import Manifold
+from ._averager import RTWAverager, _check_labels, _encode
+
+
+def fit_temperature(distances: np.ndarray, labels: np.ndarray) -> float:
+    """The temperature ``tau`` minimising the log-loss of ``softmax(-distances / tau)``.
+
+    Parameters
+    ----------
+    distances : ndarray of shape (n_series, n_classes)
+        DTW distances of labelled series to the class means.
+    labels : ndarray of shape (n_series,), int
+        Column of each series' class.
+
+    Returns
+    -------
+    tau : float
+        Searched in log space over 8 e-folds either side of the median distance of a
+        series to its own class mean (a bounded 1-D problem; Platt scaling's analogue with
+        one parameter). 1.0 when every distance is zero.
+    """
+    own = distances[np.arange(len(labels)), labels]
+    scale = float(np.median(own))
+    if not np.isfinite(scale) or scale <= 0:
+        scale = float(np.median(distances))
+    if not np.isfinite(scale) or scale <= 0:
+        return 1.0
+
+    def loss(log_tau: float) -> float:
+        logp = log_softmax(-distances / math.exp(log_tau), axis=1)
+        return -float(logp[np.arange(len(labels)), labels].mean())
+
+    centre = math.log(scale)
+    best = minimize_scalar(loss, bounds=(centre - 8.0, centre + 8.0), method="bounded")
+    return math.exp(best.x)
 
 
 class RTWNearestCentroid(ClassifierMixin, RTWAverager):
@@ -24,6 +61,12 @@ class RTWNearestCentroid(ClassifierMixin, RTWAverager):
 loss_step, penalty, n_components, hidden_size, warp_knots, tangent_refinements, \
 mean_iterations, dtw_window, n_jobs, random_state, device, verbose
         As in :class:`RTWAverager`.
+    temperature : float or "auto", default="auto"
+        Scale of the distances in :meth:`predict_proba`,
+        ``softmax(-d(x, mean_k) / temperature)``. ``"auto"`` fits it in ``fit`` by
+        minimising the log-loss of the training series (one DTW per training series and
+        class): raw DTW distances are in the data's units, so a fixed scale either
+        saturates to 0/1 rows or flattens to uniform ones. Predictions do not depend on it.
 
     Attributes
     ----------
@@ -31,6 +74,8 @@ mean_iterations, dtw_window, n_jobs, random_state, device, verbose
     means_ : ndarray of shape (n_classes, Z, *point_shape)
     alignments_ : list of Alignment
     manifold_ : Manifold
+    temperature_ : float
+        The temperature used by :meth:`predict_proba`.
 
     Examples
     --------
@@ -44,8 +89,51 @@ mean_iterations, dtw_window, n_jobs, random_state, device, verbose
     ['sin', 'sin', 'cos', 'cos']
     """
 
+    def __init__(
+        self,
+        manifold: str | Manifold = "euclidean",
+        method: str | None = None,
+        preset: str | None = None,
+        output_length: int | None = None,
+        n_epochs: int = 256,
+        learning_rate: float = 0.01,
+        sinc_window: int | str | None = None,
+        loss_window: int | None = None,
+        loss_step: int | None = None,
+        penalty: float | None = None,
+        warp_start: str = "auto",
+        n_components: int = 8,
+        hidden_size: int = 512,
+        warp_knots: int | str | None = "auto",
+        tangent_refinements: int | str = "auto",
+        mean_iterations: int = 5,
+        dtw_window: float | None = None,
+        n_jobs: int | None = None,
+        random_state: Any = None,
+        device: str = "cpu",
+        verbose: int = 0,
+        temperature: float | str = "auto",
+    ):
+        averager = inspect.signature(RTWAverager.__init__).parameters
+        values = locals()
+        super().__init__(**{name: values[name] for name in averager if name != "self"})
+        self.temperature = temperature
+
+    def _check_temperature(self) -> None:
+        t = self.temperature
+        if isinstance(t, str):
+            if t != "auto":
+                raise ValueError(f'temperature must be a positive number or "auto", got {t!r}')
+            return
+        if (
+            isinstance(t, bool)
+            or not isinstance(t, (int, float, np.number))
+            or not (math.isfinite(t) and t > 0)
+        ):
+            raise ValueError(f'temperature must be a positive number or "auto", got {t!r}')
+
     def fit(self, X: Any, y: Any = None):
-        """Learn one mean per class.
+        """Learn one mean per class (and the probability temperature).
 
         Parameters
         ----------
@@ -62,7 +150,15 @@ mean_iterations, dtw_window, n_jobs, random_state, device, verbose
             raise ValueError(
                 f"{type(self).__name__} requires y to be passed, but the target y is None"
             )
-        return self._fit_means(X, y, require_two_classes=True)
+        self._check_temperature()
+        self._fit_means(X, y, require_two_classes=True)
+        if self.temperature == "auto":
+            distances = self.transform(X)
+            _, codes = _encode(_check_labels(y, len(distances), True))
+            self.temperature_ = fit_temperature(distances, codes)
+        else:
+            self.temperature_ = float(self.temperature)
+        return self
 
     def predict(self, X: Any) -> np.ndarray:
         """Label of the nearest class mean.
@@ -80,7 +176,7 @@ mean_iterations, dtw_window, n_jobs, random_state, device, verbose
         return self.classes_[np.argmin(distances, axis=1)]
 
     def predict_proba(self, X: Any) -> np.ndarray:
-        """Softmax of the negative DTW distances to the class means.
+        """Softmax of the negative DTW distances to the class means over ``temperature_``.
 
         Parameters
         ----------
@@ -91,7 +187,8 @@ mean_iterations, dtw_window, n_jobs, random_state, device, verbose
         -------
         proba : ndarray of shape (n_series, n_classes)
         """
-        return softmax(-self.transform(X), axis=1)
+        distances = self.transform(X)
+        return softmax(-distances / self.temperature_, axis=1)
 
     def decision_function(self, X: Any) -> np.ndarray:
         """Confidence scores: negative DTW distances to the class means.
