@@ -94,12 +94,16 @@ def verdict(records: list[dict], methods: list[str]) -> list[str]:
     ranks = np.mean([rankdata(-row) for row in acc], axis=0)
     means = acc.mean(0)
     order = np.argsort(ranks, kind="stable")
-    best = methods[order[0]]
+    best, most_accurate = methods[order[0]], methods[int(np.argmax(means))]
     lines = [
         f"Verdict over {len(names)} dataset(s) where all {len(methods)} methods ran: "
-        f"{best} has the best mean rank ({ranks[order[0]]:.2f}) and mean accuracy "
-        f"{means[order[0]]:.4f}; the most accurate on average is "
-        f"{methods[int(np.argmax(means))]} ({means.max():.4f})."
+        f"{best} has the best mean rank ({ranks[order[0]]:.2f}, mean accuracy "
+        f"{means[order[0]]:.4f})"
+        + (
+            "."
+            if most_accurate == best
+            else f"; the highest mean accuracy is {most_accurate}'s ({means.max():.4f})."
+        )
     ]
     if "rtw" in methods:
         i = methods.index("rtw")
