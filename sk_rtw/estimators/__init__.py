@@ -2,11 +2,13 @@
 
 from ._averager import NTWAverager, RTWAverager, TTWAverager
 from ._classifier import NTWNearestCentroid, RTWNearestCentroid, TTWNearestCentroid
+from ._kmeans import RTWKMeans
 
 __all__ = [
     "NTWAverager",
     "NTWNearestCentroid",
     "RTWAverager",
+    "RTWKMeans",
     "RTWNearestCentroid",
     "TTWAverager",
     "TTWNearestCentroid",

@@ -1,0 +1,341 @@
+"""k-means of time series on a manifold: assignment by manifold DTW, centres by averaging."""
+
+from __future__ import annotations
+
+import sys
+import time
+from typing import Any
+
+import numpy as np
+from sklearn.base import BaseEstimator, ClusterMixin, TransformerMixin
+from sklearn.utils import check_random_state
+from sklearn.utils.validation import check_is_fitted
+
+from .._numba import check_n_jobs
+from .._random import check_random_state_value
+from ..dtw import dtw_pairwise_distance
+from ..dtw._dtw import _check_window as check_window
+from ..manifolds import Manifold
+from ..utils import SeriesCollection, check_series_collection
+from ._averager import ESTIMATOR_METHODS, RTWAverager
+
+
+def _check_count(name: str, value: Any, minimum: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:
+        raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
+    return int(value)
+
+
+def _check_tol(tol: Any) -> float:
+    if (
+        isinstance(tol, bool)
+        or not isinstance(tol, (int, float, np.number))
+        or not (np.isfinite(tol) and tol >= 0)
+    ):
+        raise ValueError(f"tol must be a non-negative number, got {tol!r}")
+    return float(tol)
+
+
+class RTWKMeans(ClusterMixin, TransformerMixin, BaseEstimator):
+    """k-means clustering of time series on a Riemannian manifold.
+
+    Lloyd's iterations with manifold DTW: every series goes to the centre nearest in
+    manifold DTW, every centre is the time-warping average of its series (RTW, TTW, NTW
+    or manifold DBA, as in :class:`RTWAverager`), until the assignment stops changing or
+    the inertia improves by less than ``tol``; the best iterate is kept. The distance is
+    ``sqrt`` of the DTW with squared geodesic point costs (tslearn's ``dtw`` on Euclidean
+    data), so the inertia is the sum of squared-cost DTW values: the objective DBA
+    minimises, and tslearn's ``TimeSeriesKMeans(metric="dtw")`` inertia. Centres start by
+    k-means++ seeding with DTW distances (Arthur and Vassilvitskii, 2007); ``n_init``
+    seedings are run and the one with the lowest inertia is kept. A cluster that empties
+    is re-seeded with the series farthest from its centre.
+
+    Parameters
+    ----------
+    n_clusters : int, default=3
+    method : {"rtw", "ttw", "ntw", "dba"}, default="rtw"
+        Averaging method of the centres. ``"dba"`` is much faster (no training); the
+        engine's methods train one warp model per cluster and iteration.
+    manifold : str or Manifold, default="euclidean"
+        Space of the samples; a name takes its dimension from the data.
+    n_init : int, default=1
+        k-means++ seedings; the clustering with the lowest inertia is kept.
+    max_iter : int, default=10
+        Assignment/update rounds per seeding.
+    tol : float, default=1e-4
+        Stop when the inertia improves by less than this fraction.
+    output_length : int, optional
+        Length of the centres (default: the longest series; see :class:`RTWAverager`).
+    n_epochs : int, default=256
+        Adam epochs of each centre fit (RTW, TTW, NTW).
+    preset : {"default", "paper"} or None, default=None
+        Engine preset of the centre fits.
+    dtw_window : float in [0, 1], optional
+        Sakoe–Chiba band of every DTW (assignment and DBA).
+    n_jobs : int, optional
+        Centres fitted in parallel and threads of the DTW computations.
+    random_state : int, RandomState or None
+        Seeds the k-means++ seeding and the centre fits.
+    device : str, default="cpu"
+        Torch device of the centre fits.
+    verbose : int, default=0
+        1: a line per iteration (inertia, changed assignments, time); 2: also per centre.
+
+    Attributes
+    ----------
+    cluster_centers_ : ndarray of shape (n_clusters, Z, *point_shape) or list
+        One centre per cluster, on the manifold (a list when lengths differ).
+    labels_ : ndarray of shape (n_series,)
+        Cluster of every training series.
+    inertia_ : float
+        Sum over the training series of the squared distance to their centre.
+    n_iter_ : int
+        Rounds run by the kept seeding (its best iterate is returned).
+    manifold_ : Manifold
+    n_features_in_ : int
+        Length of the training series when they are univariate of one length.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sk_rtw import RTWKMeans
+    >>> t = np.linspace(0, 1, 40)
+    >>> X = np.stack([np.sin(2 * np.pi * t ** p) for p in (0.8, 1.0, 1.2)]
+    ...              + [np.cos(2 * np.pi * t ** p) for p in (0.8, 1.0, 1.2)])
+    >>> km = RTWKMeans(n_clusters=2, method="dba", random_state=0).fit(X)
+    >>> km.labels_.tolist()
+    [0, 0, 0, 1, 1, 1]
+    """
+
+    def __init__(
+        self,
+        n_clusters: int = 3,
+        method: str = "rtw",
+        manifold: str | Manifold = "euclidean",
+        n_init: int = 1,
+        max_iter: int = 10,
+        tol: float = 1e-4,
+        output_length: int | None = None,
+        n_epochs: int = 256,
+        preset: str | None = None,
+        dtw_window: float | None = None,
+        n_jobs: int | None = None,
+        random_state: Any = None,
+        device: str = "cpu",
+        verbose: int = 0,
+    ):
+        self.n_clusters = n_clusters
+        self.method = method
+        self.manifold = manifold
+        self.n_init = n_init
+        self.max_iter = max_iter
+        self.tol = tol
+        self.output_length = output_length
+        self.n_epochs = n_epochs
+        self.preset = preset
+        self.dtw_window = dtw_window
+        self.n_jobs = n_jobs
+        self.random_state = random_state
+        self.device = device
+        self.verbose = verbose
+
+    # ------------------------------------------------------------------ fit
+    def _check_params(self) -> None:
+        _check_count("n_clusters", self.n_clusters, 1)
+        _check_count("n_init", self.n_init, 1)
+        _check_count("max_iter", self.max_iter, 1)
+        _check_tol(self.tol)
+        if not isinstance(self.method, str) or self.method.lower() not in ESTIMATOR_METHODS:
+            raise ValueError(f"method must be one of {ESTIMATOR_METHODS}, got {self.method!r}")
+        check_random_state_value(self.random_state)
+        check_n_jobs(self.n_jobs)
+        check_window(self.dtw_window, name="dtw_window")
+
+    def fit(self, X: Any, y: Any = None):
+        """Cluster the series.
+
+        Parameters
+        ----------
+        X : array-like of shape (n_series, n_timepoints[, *point_shape]) or list
+            Series on the manifold (a list of ``(T_i, *point_shape)`` arrays for unequal
+            lengths).
+        y : ignored
+
+        Returns
+        -------
+        self
+        """
+        self._check_params()
+        collection = check_series_collection(X, self.manifold)
+        if collection.n_series < self.n_clusters:
+            raise ValueError(
+                f"n_clusters={self.n_clusters} needs at least as many series; got "
+                f"{collection.n_series}"
+            )
+        rng = check_random_state(self.random_state)
+        best = None
+        for run in range(self.n_init):
+            outcome = self._lloyd(collection, rng, run)
+            if best is None or outcome[2] < best[2]:
+                best = outcome
+        assert best is not None
+        centres, labels, inertia, n_iter = best
+        self.manifold_ = collection.manifold
+        same_length = len({len(c) for c in centres}) == 1
+        self.cluster_centers_ = np.stack(centres) if same_length else centres
+        self.labels_ = labels
+        self.inertia_ = float(inertia)
+        self.n_iter_ = n_iter
+        if collection.equal_length and collection.manifold.point_shape == (1,):
+            self.n_features_in_ = collection.max_length
+        return self
+
+    def _distances(self, collection: SeriesCollection, centres) -> np.ndarray:
+        means = check_series_collection(list(centres), collection.manifold, name="centres")
+        squared = dtw_pairwise_distance(
+            collection, means, window=self.dtw_window, squared=True, n_jobs=self.n_jobs
+        )
+        return np.sqrt(squared)
+
+    def _seed(self, collection: SeriesCollection, rng) -> list[np.ndarray]:
+        """k-means++ with DTW: each new centre drawn with probability ~ squared distance."""
+        n = collection.n_series
+        chosen = [int(rng.randint(n))]
+        nearest = self._distances(collection, [collection.series(chosen[0])])[:, 0]
+        for _ in range(1, self.n_clusters):
+            weights = nearest**2
+            total = weights.sum()
+            if total > 0 and np.isfinite(total):
+                pick = int(rng.choice(n, p=weights / total))
+            else:  # every series sits on a chosen one: take any other
+                pick = int(rng.choice(np.setdiff1d(np.arange(n), chosen)))
+            chosen.append(pick)
+            new = self._distances(collection, [collection.series(pick)])[:, 0]
+            nearest = np.minimum(nearest, new)
+        return [collection.series(i) for i in chosen]
+
+    def _average(self, collection: SeriesCollection, labels: np.ndarray, seed: int):
+        averager = RTWAverager(
+            manifold=collection.manifold,
+            method=self.method.lower(),
+            preset=self.preset,
+            output_length=self.output_length,
+            n_epochs=self.n_epochs,
+            dtw_window=self.dtw_window,
+            n_jobs=self.n_jobs,
+            random_state=seed,
+            device=self.device,
+            verbose=max(0, self.verbose - 1),
+        ).fit(collection, labels)
+        return list(averager.means_)
+
+    def _lloyd(self, collection: SeriesCollection, rng, run: int):
+        centres = self._seed(collection, rng)
+        distances = self._distances(collection, centres)
+        labels = distances.argmin(1)
+        inertia = _inertia(distances, labels)
+        best = None
+        n_iter = 0
+        for n_iter in range(1, self.max_iter + 1):
+            start = time.perf_counter()
+            labels, reseeded = _fill_empty(labels, distances, self.n_clusters)
+            fitted = self._average(collection, labels, int(rng.randint(2**31 - 1)))
+            centres = list(fitted)
+            distances = self._distances(collection, centres)
+            new_labels = distances.argmin(1)
+            new_inertia = _inertia(distances, new_labels)
+            changed = int((new_labels != labels).sum())
+            if self.verbose:
+                print(
+                    f"[RTWKMeans] init {run + 1}/{self.n_init} iteration {n_iter}: inertia "
+                    f"{new_inertia:.6g}, {changed} series changed cluster"
+                    + (f", {reseeded} empty cluster(s) re-seeded" if reseeded else "")
+                    + f", {time.perf_counter() - start:.1f} s",
+                    file=sys.stderr,
+                    flush=True,
+                )
+            improved = inertia - new_inertia
+            labels, inertia = new_labels, new_inertia
+            if np.all(np.bincount(labels, minlength=self.n_clusters) > 0) and (
+                best is None or inertia < best[2]
+            ):
+                best = (centres, labels, inertia, n_iter)
+            if changed == 0 or (reseeded == 0 and improved <= self.tol * abs(inertia)):
+                break
+        if best is None:  # every iterate left a cluster empty: keep the last, filled
+            labels, _ = _fill_empty(labels, distances, self.n_clusters)
+            best = (centres, labels, _inertia(distances, labels), n_iter)
+        return best[0], best[1], best[2], n_iter  # the best iterate, the rounds run
+
+    # ------------------------------------------------------------ inference
+    def transform(self, X: Any) -> np.ndarray:
+        """Manifold-DTW distance of every series to every centre.
+
+        Parameters
+        ----------
+        X : array-like or list of series
+            Series of any length on the training manifold.
+
+        Returns
+        -------
+        distances : ndarray of shape (n_series, n_clusters)
+        """
+        check_is_fitted(self, "cluster_centers_")
+        collection = check_series_collection(X, self.manifold_, min_length=1)
+        return self._distances(collection, self.cluster_centers_)
+
+    def predict(self, X: Any) -> np.ndarray:
+        """Index of the nearest centre.
+
+        Parameters
+        ----------
+        X : array-like or list of series
+            Series of any length on the training manifold.
+
+        Returns
+        -------
+        labels : ndarray of shape (n_series,)
+        """
+        return self.transform(X).argmin(1)
+
+    def fit_predict(self, X: Any, y: Any = None, **kwargs) -> np.ndarray:
+        """Cluster the series and return ``labels_``.
+
+        Parameters
+        ----------
+        X : array-like or list of series
+        y : ignored
+
+        Returns
+        -------
+        labels : ndarray of shape (n_series,)
+        """
+        return self.fit(X).labels_
+
+    def __sklearn_tags__(self):
+        tags = super().__sklearn_tags__()
+        tags.input_tags.allow_nan = False
+        tags.non_deterministic = False
+        return tags
+
+
+def _inertia(distances: np.ndarray, labels: np.ndarray) -> float:
+    return float((distances[np.arange(len(labels)), labels] ** 2).sum())
+
+
+def _fill_empty(
+    labels: np.ndarray, distances: np.ndarray, n_clusters: int
+) -> tuple[np.ndarray, int]:
+    """Give every empty cluster the series farthest from its own centre (scikit-learn's
+    rule), never emptying another cluster; returns the labels and how many were filled."""
+    labels = labels.copy()
+    filled = 0
+    for k in range(n_clusters):
+        if np.any(labels == k):
+            continue
+        own = distances[np.arange(len(labels)), labels].copy()
+        sizes = np.bincount(labels, minlength=n_clusters)
+        own[sizes[labels] < 2] = -np.inf  # a series alone in its cluster stays there
+        labels[int(np.argmax(own))] = k
+        filled += 1
+    return labels, filled

@@ -1,0 +1,168 @@
+"""RTWKMeans and several centroids per class."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from sklearn.metrics import adjusted_rand_score
+from sklearn.model_selection import GridSearchCV
+from sklearn.utils.estimator_checks import parametrize_with_checks
+
+from sk_rtw import RTWAverager, RTWKMeans, RTWNearestCentroid
+from sk_rtw.datasets import make_warped_signals
+from sk_rtw.estimators._kmeans import _fill_empty
+from sk_rtw.manifolds import Sphere
+
+from .test_estimators import EXPECTED_FAILURES
+
+
+def three_shapes(manifold="euclidean", n_per=6, length=40, seed=0):
+    """Warped copies of three different originals: the clusters are the originals."""
+    rng = np.random.default_rng(seed)
+    t = np.linspace(0, 1, length)
+    X, y = [], []
+    for k, freq in enumerate((1.0, 2.0, 3.0)):
+        if manifold == "euclidean":
+            original = np.sin(2 * np.pi * freq * t)[:, None] + k
+        else:  # a curve on S^2
+            angle = np.pi * (0.2 + 0.6 * t)
+            phase = freq * 3 * t + k
+            original = np.stack(
+                [np.sin(angle) * np.cos(phase), np.sin(angle) * np.sin(phase), np.cos(angle)],
+                axis=1,
+            )
+        data = make_warped_signals(
+            Sphere(2) if manifold == "sphere" else manifold,
+            n_per,
+            original=original,
+            random_state=int(rng.integers(1000)),
+        )
+        X.append(np.asarray(data.signals))
+        y += [k] * n_per
+    return np.concatenate(X), np.array(y)
+
+
+@parametrize_with_checks(
+    [RTWKMeans(n_clusters=2, method="dba", random_state=0),
+     RTWKMeans(n_clusters=2, n_epochs=2, max_iter=2, random_state=0)],
+    expected_failed_checks=lambda est: EXPECTED_FAILURES,
+)  # fmt: skip
+def test_sklearn_compatible(estimator, check):
+    check(estimator)
+
+
+@pytest.mark.parametrize("method", ["dba", "rtw"])
+def test_recovers_warped_copies_of_three_shapes(method):
+    X, y = three_shapes()
+    km = RTWKMeans(3, method=method, n_epochs=32, n_init=2, random_state=0).fit(X)
+    assert adjusted_rand_score(y, km.labels_) == 1.0
+    assert km.cluster_centers_.shape == (3, 40, 1)
+    np.testing.assert_array_equal(km.predict(X), km.labels_)
+    assert km.transform(X).shape == (18, 3)
+
+
+def test_clusters_curves_on_the_sphere():
+    X, y = three_shapes("sphere")
+    km = RTWKMeans(3, method="dba", manifold="sphere", n_init=2, random_state=0).fit(X)
+    assert adjusted_rand_score(y, km.labels_) == 1.0
+    centres = km.cluster_centers_
+    np.testing.assert_allclose(np.linalg.norm(centres, axis=-1), 1.0, atol=1e-9)  # on S^2
+    assert isinstance(km.manifold_, Sphere)
+
+
+def test_inertia_is_the_sum_of_squared_cost_dtw_as_aeon_computes_it():
+    from aeon.distances import dtw_distance
+
+    X, _ = three_shapes()
+    km = RTWKMeans(3, method="dba", random_state=0).fit(X)
+    expected = sum(
+        dtw_distance(x[:, 0], km.cluster_centers_[k][:, 0])  # aeon: sum of squared costs
+        for x, k in zip(X, km.labels_, strict=True)
+    )
+    assert km.inertia_ == pytest.approx(expected, rel=1e-9)
+    own = [km.cluster_centers_[k][:, 0] for k in km.labels_]
+    np.testing.assert_allclose(
+        km.transform(X).min(1) ** 2,
+        [dtw_distance(x[:, 0], c) for x, c in zip(X, own, strict=True)],
+        rtol=1e-9,
+    )
+
+
+def test_more_seedings_never_raise_the_inertia():
+    X, _ = three_shapes(seed=3)
+    one = RTWKMeans(3, method="dba", n_init=1, random_state=5).fit(X)
+    many = RTWKMeans(3, method="dba", n_init=4, random_state=5).fit(X)
+    assert many.inertia_ <= one.inertia_ + 1e-9  # the first seeding is among the four
+
+
+def test_empty_clusters_take_the_farthest_series_of_a_shared_cluster():
+    distances = np.array([[0.0, 5.0, 5.0], [1.0, 5.0, 5.0], [9.0, 5.0, 5.0], [0.5, 0.2, 5.0]])
+    labels = np.array([0, 0, 0, 1])
+    filled, count = _fill_empty(labels, distances, 3)
+    assert count == 1
+    np.testing.assert_array_equal(filled, [0, 0, 2, 1])  # series 2 is farthest from its centre
+    alone = _fill_empty(np.array([0, 1]), np.array([[9.0, 1.0], [1.0, 0.0]]), 2)
+    np.testing.assert_array_equal(alone[0], [0, 1])  # nothing to fill, nothing moved
+
+
+def test_identical_series_still_give_n_clusters():
+    X = np.tile(np.sin(np.linspace(0, 3, 20)), (5, 1))
+    km = RTWKMeans(3, method="dba", random_state=0).fit(X)
+    assert sorted(set(km.labels_.tolist())) == [0, 1, 2]
+    assert km.inertia_ == pytest.approx(0.0, abs=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("params", "match"),
+    [
+        ({"n_clusters": 0}, "n_clusters"),
+        ({"n_clusters": 2.5}, "n_clusters"),
+        ({"n_init": 0}, "n_init"),
+        ({"max_iter": 0}, "max_iter"),
+        ({"tol": -1.0}, "tol"),
+        ({"method": "kmeans"}, "method"),
+        ({"dtw_window": 2.0}, "dtw_window"),
+        ({"n_clusters": 50}, "at least as many series"),
+    ],
+)
+def test_bad_parameters_are_named(params, match):
+    X, _ = three_shapes()
+    with pytest.raises(ValueError, match=match):
+        RTWKMeans(**{"method": "dba", **params}).fit(X)
+
+
+# ---------------------------------------------------------- several centroids per class
+
+
+def test_one_centroid_per_class_is_the_plain_classifier():
+    X, y = three_shapes()
+    plain = RTWNearestCentroid(method="dba", random_state=0).fit(X, y)
+    one = RTWNearestCentroid(method="dba", n_centroids=1, random_state=0).fit(X, y)
+    np.testing.assert_array_equal(plain.means_, one.means_)
+    np.testing.assert_array_equal(one.centroid_classes_, [0, 1, 2])
+
+
+def test_several_centroids_capture_a_class_made_of_two_shapes():
+    X, y = three_shapes()
+    y = np.where(y == 2, 0, y)  # class 0: two different shapes; its mean fits neither
+    one = RTWNearestCentroid(method="dba", random_state=0).fit(X, y)
+    two = RTWNearestCentroid(method="dba", n_centroids=2, random_state=0).fit(X, y)
+    assert len(two.means_) == 4 and two.centroid_classes_.tolist() == [0, 0, 1, 1]
+    distances = two.transform(X)
+    assert distances.shape == (18, 2)
+    all_centroids = RTWAverager.transform(two, X)  # to every centroid
+    np.testing.assert_allclose(distances[:, 0], all_centroids[:, :2].min(1))
+    assert two.score(X, y) == 1.0
+    assert two.score(X, y) >= one.score(X, y)
+
+
+def test_n_centroids_is_searchable_and_validated():
+    X, y = three_shapes()
+    search = GridSearchCV(
+        RTWNearestCentroid(method="dba", random_state=0), {"n_centroids": [1, 2]}, cv=2
+    ).fit(X, y)
+    assert search.best_params_["n_centroids"] in (1, 2)
+    with pytest.raises(ValueError, match="n_centroids"):
+        RTWNearestCentroid(method="dba", n_centroids=0).fit(X, y)
+    few = RTWNearestCentroid(method="dba", n_centroids=10).fit(X, y)  # capped per class
+    assert len(few.means_) == 18
