@@ -1,0 +1,210 @@
+"""Clustering and several centroids per class: RTWKMeans against tslearn and 1-NN DTW.
+
+Usage::
+
+    python benchmarks/clustering.py                                 # aeon's bundled data
+    python benchmarks/clustering.py --data-dir ../shared/ucr --all  # the development archive
+    python benchmarks/clustering.py --sections manifolds --demo-dir ../shared/data
+
+Prints
+1. ``tslearn``: RTWKMeans (DBA and RTW centres) beside tslearn's
+   ``TimeSeriesKMeans(metric="dtw")`` on Euclidean UCR training sets, ``k`` = number of
+   classes, ``n_init`` 2, ``max_iter`` 10: inertia (the same measure for both: sum of
+   squared-cost DTW of each series to its centre, recomputed with sk_rtw's DTW), adjusted
+   Rand index against the labels, seconds. Needs ``pip install tslearn`` (skipped
+   otherwise).
+2. ``manifolds``: RTWKMeans where no peer runs: RCFS letters on S^2 and S^3, R-LASA shapes
+   on S^3 and SPD(2) (demonstrations from ``--demo-dir``), ARI against the shape labels.
+3. ``centroids``: nearest centroid with ``n_centroids`` = 1, 2, 4, 8 DBA centroids per
+   class against 1-NN DTW (both with sk_rtw's DTW, absolute point cost): test accuracy
+   and prediction seconds, per dataset, and the count of datasets where some ``k`` /
+   ``k = 4`` is at least as accurate as 1-NN DTW.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+from sklearn.metrics import adjusted_rand_score
+
+ROOT = Path(__file__).resolve().parents[1]
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
+
+from benchmarks.ucr._data import AEON_BUNDLED, available_datasets, load_split  # noqa: E402
+from sk_rtw import RTWKMeans, RTWNearestCentroid, dtw_pairwise_distance  # noqa: E402
+from sk_rtw.manifolds import Sphere  # noqa: E402
+
+CENTROIDS = (1, 2, 4, 8)
+SECTIONS = ("tslearn", "manifolds", "centroids")
+
+
+def inertia(X, centres, labels) -> float:
+    """Sum of squared-cost DTW of every series to its own centre (sk_rtw's DTW)."""
+    d = dtw_pairwise_distance(X, np.asarray(centres), squared=True)
+    return float(d[np.arange(len(labels)), labels].sum())
+
+
+def section_tslearn(names, data_dir, epochs: int) -> None:
+    try:
+        from tslearn.clustering import TimeSeriesKMeans
+    except ImportError:
+        print("\n1. tslearn not installed (pip install tslearn): section skipped")
+        return
+    print(f"\n1. RTWKMeans vs tslearn TimeSeriesKMeans(metric='dtw'), k = classes, "
+          f"n_init 2, max_iter 10 (RTW: {epochs} epochs)")  # fmt: skip
+    head = f"{'dataset':>26} {'n':>5} {'k':>3} | {'inertia':>30} | {'ARI':>20} | {'seconds':>20}"
+    print(
+        head
+        + "\n"
+        + " " * 37
+        + "| tslearn      dba      rtw | tslearn  dba   rtw | tslearn  dba  rtw"
+    )
+    for name in names:
+        split = load_split(name, "train", data_dir)
+        if not isinstance(split.X, np.ndarray) or split.X.ndim != 2:
+            continue
+        X, y = split.X, split.y
+        k = len(np.unique(y))
+        rows = {}
+        start = time.perf_counter()
+        tk = TimeSeriesKMeans(k, metric="dtw", n_init=2, max_iter=10, random_state=0).fit(
+            X[..., None]
+        )
+        seconds = time.perf_counter() - start
+        score = inertia(X, tk.cluster_centers_[..., 0], tk.labels_)
+        rows["tslearn"] = (score, adjusted_rand_score(y, tk.labels_), seconds)
+        for method in ("dba", "rtw"):
+            start = time.perf_counter()
+            km = RTWKMeans(k, method=method, n_init=2, max_iter=10, n_epochs=epochs,
+                           random_state=0).fit(X)  # fmt: skip
+            rows[method] = (km.inertia_, adjusted_rand_score(y, km.labels_),
+                            time.perf_counter() - start)  # fmt: skip
+        cells = [
+            " ".join(f"{rows[m][i]:>8.4g}" for m in ("tslearn", "dba", "rtw")) for i in range(3)
+        ]
+        print(f"{name:>26} {len(X):>5} {k:>3} | {cells[0]} | {cells[1]} | {cells[2]}", flush=True)
+
+
+def manifold_datasets(demo_dir: Path):
+    """(name, manifold, series, labels) of labelled demonstrations on curved manifolds."""
+    from benchmarks.paper._data import (
+        letters_on_s3,
+        rcfs_letter,
+        rlasa_quaternions,
+        rlasa_spd,
+    )
+
+    letters = ("A", "C", "G", "L", "S", "W")
+    positions = [rcfs_letter(demo_dir, L)[:, ::4] for L in letters]  # (n, 50, 2) each
+    labels = np.concatenate([[i] * len(p) for i, p in enumerate(positions)])
+    stacked = np.concatenate(positions)
+    scale = 0.5 / np.abs(stacked).max()
+    tangent = np.concatenate([scale * stacked, np.zeros((*stacked.shape[:2], 1))], axis=-1)
+    north = np.broadcast_to(np.array([0.0, 0.0, 1.0]), tangent.shape)
+    on_s2 = Sphere(2).exp(north, tangent)
+    yield "RCFS letters on S^2", "sphere", on_s2, labels
+    yield "RCFS letters on S^3", "quaternion", letters_on_s3(stacked, 2 * scale), labels
+    shapes = ("BendedLine", "CShape", "GShape", "Khamesh", "Sshape", "Worm")
+    quats = [rlasa_quaternions(demo_dir, s)[:, ::10] for s in shapes]
+    spds = [rlasa_spd(demo_dir, s)[:, ::10] for s in shapes]
+    shape_labels = np.concatenate([[i] * len(q) for i, q in enumerate(quats)])
+    yield "R-LASA shapes on S^3", "quaternion", np.concatenate(quats), shape_labels
+    yield "R-LASA shapes on SPD(2)", "spd", np.concatenate(spds), shape_labels
+
+
+def section_manifolds(demo_dir: str | None, epochs: int) -> None:
+    from benchmarks.paper._data import data_dir
+
+    try:
+        root = data_dir(demo_dir)
+    except FileNotFoundError as exc:
+        print(f"\n2. {exc}: section skipped")
+        return
+    print(f"\n2. RTWKMeans on curved manifolds (no peer runs here), k = shapes, n_init 2 "
+          f"(RTW: {epochs} epochs)")  # fmt: skip
+    print(f"{'data':>24} {'n':>4} {'T':>4} {'k':>3} | {'ARI dba':>8} {'ARI rtw':>8} | "
+          f"{'s dba':>6} {'s rtw':>6}")  # fmt: skip
+    for name, manifold, X, y in manifold_datasets(root):
+        k = len(np.unique(y))
+        out = {}
+        for method in ("dba", "rtw"):
+            start = time.perf_counter()
+            km = RTWKMeans(k, method=method, manifold=manifold, n_init=2, n_epochs=epochs,
+                           random_state=0).fit(X)  # fmt: skip
+            out[method] = (adjusted_rand_score(y, km.labels_), time.perf_counter() - start)
+        print(f"{name:>24} {len(X):>4} {X.shape[1]:>4} {k:>3} | {out['dba'][0]:>8.3f} "
+              f"{out['rtw'][0]:>8.3f} | {out['dba'][1]:>6.1f} {out['rtw'][1]:>6.1f}",
+              flush=True)  # fmt: skip
+
+
+def section_centroids(names, data_dir) -> None:
+    print("\n3. Nearest centroid with k DBA centroids per class vs 1-NN DTW (accuracy; "
+          "prediction seconds)")  # fmt: skip
+    ks = " ".join(f"{'k=' + str(k):>7}" for k in CENTROIDS)
+    print(f"{'dataset':>26} | {ks} {'1-NN':>7} | {'pred k=4':>9} {'pred 1-NN':>9} {'x':>6}")
+    wins_any = wins_4 = speedups = n = 0
+    ratios = []
+    for name in names:
+        train, test = load_split(name, "train", data_dir), load_split(name, "test", data_dir)
+        accuracy, predict_seconds = {}, {}
+        for k in CENTROIDS:
+            clf = RTWNearestCentroid(method="dba", n_centroids=k, random_state=0, n_jobs=-1)
+            clf.fit(train.X, train.y)
+            start = time.perf_counter()
+            accuracy[k] = float((clf.predict(test.X) == test.y).mean())
+            predict_seconds[k] = time.perf_counter() - start
+        start = time.perf_counter()
+        nearest = dtw_pairwise_distance(test.X, train.X, n_jobs=-1).argmin(1)
+        one_nn_seconds = time.perf_counter() - start
+        one_nn = float((train.y[nearest] == test.y).mean())
+        ratio = one_nn_seconds / max(predict_seconds[4], 1e-9)
+        ratios.append(ratio)
+        n += 1
+        wins_any += max(accuracy.values()) >= one_nn
+        wins_4 += accuracy[4] >= one_nn
+        speedups += ratio >= 10
+        cells = " ".join(f"{accuracy[k]:>7.3f}" for k in CENTROIDS)
+        print(f"{name:>26} | {cells} {one_nn:>7.3f} | {predict_seconds[4]:>9.3f} "
+              f"{one_nn_seconds:>9.3f} {ratio:>6.1f}", flush=True)  # fmt: skip
+    if n:
+        print(f"\nAt least as accurate as 1-NN DTW: some k on {wins_any}/{n} datasets, k = 4 on "
+              f"{wins_4}/{n}. Prediction with k = 4 at least 10x faster than 1-NN DTW on "
+              f"{speedups}/{n} (median {np.median(ratios):.1f}x).")  # fmt: skip
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(
+        description=__doc__.splitlines()[0],
+        epilog=__doc__.split("Usage::")[1].split("Prints")[0],
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("--data-dir", help="UCR archive in aeon's local layout")
+    parser.add_argument("--all", action="store_true", help="every dataset in --data-dir")
+    parser.add_argument("--datasets", nargs="+", help=f"default: {', '.join(AEON_BUNDLED)}")
+    parser.add_argument("--demo-dir", help="demonstration data (default ../shared/data)")
+    parser.add_argument("--sections", nargs="+", choices=SECTIONS, default=list(SECTIONS))
+    parser.add_argument("--epochs", type=int, default=64, help="RTW epochs per centre fit")
+    args = parser.parse_args(argv)
+    warnings.filterwarnings("ignore", module="tslearn")
+    if args.datasets:
+        names = args.datasets
+    elif args.all:
+        names = available_datasets(args.data_dir)
+    else:
+        names = list(AEON_BUNDLED)
+    if "tslearn" in args.sections:
+        section_tslearn(names, args.data_dir, args.epochs)
+    if "manifolds" in args.sections:
+        section_manifolds(args.demo_dir, args.epochs)
+    if "centroids" in args.sections:
+        section_centroids(names, args.data_dir)
+
+
+if __name__ == "__main__":
+    main()
