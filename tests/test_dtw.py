@@ -180,9 +180,9 @@ def test_invalid_normalize_and_bad_series():
         dtw_distance(np.ones((4, 3)), np.ones((4, 3)), SPD(2))
 
 
-def test_product_without_numba_segments_uses_general_path():
+def test_product_without_distance_segments_uses_general_path():
     M = Product((Sphere(2), SPD(2)))
-    assert M.numba_segments is None
+    assert M.distance_segments is None
     rng = np.random.default_rng(0)
     X = np.concatenate(
         [Sphere(2).random_point((3, 6), rng), SPD(2).random_point((3, 6), rng).reshape(3, 6, 4)],

@@ -28,7 +28,7 @@ from collections.abc import Callable
 import numpy as np
 import torch
 
-from ..dtw._paths import medoid_index, path_indices
+from ..dtw import medoid_index, path_indices
 from ..utils import SeriesCollection
 
 #: Series among which the first reference (the DTW medoid) is chosen.

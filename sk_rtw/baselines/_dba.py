@@ -7,8 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from ..dtw._dtw import _check_window
-from ..dtw._paths import medoid_index, path_indices
+from ..dtw import check_window, medoid_index, path_indices
 from ..manifolds import Manifold
 from ..utils import check_series_collection
 from ._result import MultipleAlignment, grouped_mean, make_result
@@ -75,7 +74,7 @@ def dba_average(
         raise ValueError(f"n_iter must be a positive integer, got {n_iter!r}")
     collection = check_series_collection(X, manifold, name="X", min_length=1)
     M = collection.manifold
-    w = _check_window(window)
+    w = check_window(window)
     series = [collection.series(i) for i in range(collection.n_series)]
     mean = _initial_mean(collection, init, window, squared)
     best: tuple[float, np.ndarray, tuple[np.ndarray, ...]] | None = None

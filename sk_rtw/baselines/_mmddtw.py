@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from .._resources import available_memory
-from ..dtw._dtw import _check_window, point_cost_matrix
+from ..dtw import check_window, point_cost_matrix
 from ..manifolds import SPD, Euclidean, Manifold
 from ..utils import check_series_collection
 from . import _nd_kernels
@@ -70,7 +70,7 @@ def nd_dtw(
     """
     lengths = np.array([len(s) for s in series], dtype=np.int64)
     _check_memory(lengths, max_memory)
-    w = _check_window(window)
+    w = check_window(window)
     pairs = np.array(list(itertools.combinations(range(len(series)), 2)), dtype=np.int64)
     t_max = int(lengths.max())
     costs = np.zeros((len(pairs), t_max, t_max))

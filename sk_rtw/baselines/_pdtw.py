@@ -6,8 +6,7 @@ from typing import Any
 
 import numpy as np
 
-from ..dtw._dtw import _check_window
-from ..dtw._paths import path_indices
+from ..dtw import check_window, path_indices
 from ..manifolds import Manifold
 from ..utils import check_series_collection
 from ._result import MultipleAlignment, make_result
@@ -52,7 +51,7 @@ def pdtw_average(
     """
     collection = check_series_collection(X, manifold, name="X", min_length=1)
     M = collection.manifold
-    w = _check_window(window)
+    w = check_window(window)
     length = collection.max_length if output_length is None else output_length
     if isinstance(length, bool) or not isinstance(length, (int, np.integer)) or length < 1:
         raise ValueError(f"output_length must be a positive integer, got {output_length!r}")

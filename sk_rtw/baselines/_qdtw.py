@@ -6,8 +6,7 @@ from typing import Any
 
 import numpy as np
 
-from ..dtw._dtw import _check_window, point_cost_matrix
-from ..dtw._paths import optimal_path
+from ..dtw import check_window, optimal_path, point_cost_matrix
 from ..manifolds import Quaternion
 from ..utils import check_series, check_series_collection
 from ._mmddtw import nd_dtw
@@ -70,7 +69,7 @@ def qdtw(
     """
     x, _ = check_series(x, Quaternion(), name="x", min_length=1)
     y, _ = check_series(y, Quaternion(), name="y", min_length=1)
-    return optimal_path(quaternion_cost_matrix(x, y, cost), _check_window(window))
+    return optimal_path(quaternion_cost_matrix(x, y, cost), check_window(window))
 
 
 def qdtw_align(

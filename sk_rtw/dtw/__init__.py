@@ -1,17 +1,29 @@
-"""Dynamic time warping with geodesic point costs on any manifold."""
+"""Dynamic time warping with geodesic point costs on any manifold.
+
+Besides the distances, the helpers that the DTW-family baselines and the alignment
+engine share: :func:`check_window` (the Sakoe–Chiba argument), :func:`optimal_path` (a
+path through a point-cost matrix), :func:`path_indices` (the path between two series) and
+:func:`medoid_index` (the DTW medoid of a collection).
+"""
 
 from ._dtw import (
+    check_window,
     dtw_cost_matrix,
     dtw_distance,
     dtw_pairwise_distance,
     dtw_path,
     point_cost_matrix,
 )
+from ._paths import medoid_index, optimal_path, path_indices
 
 __all__ = [
+    "check_window",
     "dtw_cost_matrix",
     "dtw_distance",
     "dtw_pairwise_distance",
     "dtw_path",
+    "medoid_index",
+    "optimal_path",
+    "path_indices",
     "point_cost_matrix",
 ]

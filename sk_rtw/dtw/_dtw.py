@@ -20,7 +20,21 @@ from . import _kernels
 _NORMALIZE = (None, "path")
 
 
-def _check_window(window: float | None, name: str = "window") -> float:
+def check_window(window: float | None, name: str = "window") -> float:
+    """Check a Sakoe–Chiba radius and return it in the kernels' convention.
+
+    Parameters
+    ----------
+    window : float in [0, 1] or None
+        Radius as a fraction of the shorter series (as in aeon); None: no band.
+    name : str, default="window"
+        The argument's name in error messages.
+
+    Returns
+    -------
+    radius : float
+        ``window`` as a float, or -1.0 for no band.
+    """
     if window is None:
         return -1.0
     if isinstance(window, bool) or not isinstance(window, (int, float, np.integer, np.floating)):
@@ -54,7 +68,7 @@ def point_cost_matrix(
     -------
     C : ndarray of shape (T_x, T_y)
     """
-    segments = manifold.numba_segments
+    segments = _kernels.segment_codes(manifold)
     if segments is not None:
         out = np.empty((len(x), len(y)))
         _kernels.segment_cost_matrix(
@@ -62,7 +76,7 @@ def point_cost_matrix(
             _flat(y),
             len(x),
             len(y),
-            np.asarray(segments, dtype=np.int64),
+            segments,
             squared,
             out,
         )
@@ -108,7 +122,7 @@ def dtw_cost_matrix(
         ``D[i, j]`` is the cost of the best path from ``(0, 0)`` to ``(i, j)``;
         ``inf`` outside the band.
     """
-    w = _check_window(window)
+    w = check_window(window)
     x, y, manifold = _pair(x, y, manifold)
     return _kernels.accumulated_cost(point_cost_matrix(x, y, manifold, squared), w)
 
@@ -148,7 +162,7 @@ def dtw_distance(
     0.0
     """
     _check_normalize(normalize)
-    w = _check_window(window)
+    w = check_window(window)
     x, y, manifold = _pair(x, y, manifold)
     cost = point_cost_matrix(x, y, manifold, squared)
     if normalize == "path":
@@ -180,7 +194,7 @@ def dtw_path(
     distance : float
         As returned by :func:`dtw_distance`.
     """
-    w = _check_window(window)
+    w = check_window(window)
     x, y, manifold = _pair(x, y, manifold)
     D = _kernels.accumulated_cost(point_cost_matrix(x, y, manifold, squared), w)
     path = [(int(i), int(j)) for i, j in _kernels.backtrack(D)]
@@ -214,7 +228,7 @@ def dtw_pairwise_distance(
     distances : ndarray of shape (n_X, n_Y)
     """
     _check_normalize(normalize)
-    w = _check_window(window)
+    w = check_window(window)
     cx = (
         X
         if isinstance(X, SeriesCollection)
@@ -237,9 +251,8 @@ def _pairwise(
     cx: SeriesCollection, cy: SeriesCollection, window, squared, symmetric, per_step
 ) -> np.ndarray:
     manifold = cx.manifold
-    segments = None
-    if manifold.numba_segments is not None:
-        segments = np.asarray(manifold.numba_segments, dtype=np.int64)
+    segments = _kernels.segment_codes(manifold)
+    if segments is not None:
         flat_x = np.ascontiguousarray(cx.data.reshape(cx.n_series, cx.max_length, -1))
         flat_y = np.ascontiguousarray(cy.data.reshape(cy.n_series, cy.max_length, -1))
         if not per_step:

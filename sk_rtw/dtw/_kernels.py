@@ -5,9 +5,10 @@ once (:func:`_accumulate_row`) and used by every public function. ``fastmath`` i
 enabled: the band uses ``inf`` for forbidden cells.
 
 Point distances that numba computes itself are described by "segments" ``(start, stop,
-code)`` of a flattened point (see :attr:`sk_rtw.manifolds.Manifold.numba_segments`):
-code 0 Euclidean, 1 great-circle on a sphere, 2 sign-invariant great circle (quaternions);
-a product space is several segments, combined as ``sqrt(sum d_s^2)``.
+code)`` of a flattened point, translated by :func:`segment_codes` from the manifold's
+:attr:`~sk_rtw.manifolds.Manifold.distance_segments`: code 0 Euclidean, 1 great-circle on
+a sphere, 2 sign-invariant great circle (quaternions); a product space is several
+segments, combined as ``sqrt(sum d_s^2)``.
 """
 
 from __future__ import annotations
@@ -17,9 +18,27 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from ..manifolds._base import SEGMENT_EUCLIDEAN, SEGMENT_SIGN_INVARIANT_SPHERE
+from ..manifolds import Manifold
 
 _INF = np.inf
+
+#: The kernel's codes of the manifolds' distance kinds.
+SEGMENT_EUCLIDEAN = 0
+SEGMENT_SPHERE = 1
+SEGMENT_SIGN_INVARIANT_SPHERE = 2
+SEGMENT_CODES = {
+    "euclidean": SEGMENT_EUCLIDEAN,
+    "sphere": SEGMENT_SPHERE,
+    "sign-invariant sphere": SEGMENT_SIGN_INVARIANT_SPHERE,
+}
+
+
+def segment_codes(manifold: Manifold) -> np.ndarray | None:
+    """``(n_segments, 3)`` int64 ``(start, stop, code)`` rows, or None (no kernel form)."""
+    segments = manifold.distance_segments
+    if segments is None or any(kind not in SEGMENT_CODES for _, _, kind in segments):
+        return None
+    return np.array([(a, b, SEGMENT_CODES[kind]) for a, b, kind in segments], dtype=np.int64)
 
 
 @njit(cache=True)

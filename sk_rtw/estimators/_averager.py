@@ -18,8 +18,7 @@ from .._random import check_random_state_value
 from ..align import METHODS, Alignment, align, classification_output_length
 from ..align._config import check_preset
 from ..baselines import MultipleAlignment, dba_average
-from ..dtw import dtw_pairwise_distance
-from ..dtw._dtw import _check_window as check_window
+from ..dtw import check_window, dtw_pairwise_distance
 from ..manifolds import Manifold
 from ..utils import SeriesCollection, check_series_collection
 

@@ -13,8 +13,7 @@ from sklearn.utils.validation import check_is_fitted
 
 from .._numba import check_n_jobs
 from .._random import check_random_state_value
-from ..dtw import dtw_pairwise_distance
-from ..dtw._dtw import _check_window as check_window
+from ..dtw import check_window, dtw_pairwise_distance
 from ..manifolds import Manifold
 from ..utils import SeriesCollection, check_series_collection
 from ._averager import ESTIMATOR_METHODS, RTWAverager

@@ -29,10 +29,9 @@ MEAN_MAX_ITER = 64
 #: Magnitudes beyond ``10 ** +-EXTREME_EXPONENT`` are aligned in a rescaled frame.
 EXTREME_EXPONENT = 100
 
-# Codes of the point distances that the numba DTW kernel knows (see sk_rtw.dtw).
-SEGMENT_EUCLIDEAN = 0
-SEGMENT_SPHERE = 1
-SEGMENT_SIGN_INVARIANT_SPHERE = 2
+#: Kinds of point distance a block of coordinates can have (see
+#: :attr:`Manifold.distance_segments`).
+DISTANCE_KINDS = ("euclidean", "sphere", "sign-invariant sphere")
 
 
 def checked_geometry(points=(), vectors=(), broadcast=True):
@@ -112,11 +111,15 @@ class Manifold(ABC):
         return float("inf")
 
     @property
-    def numba_segments(self) -> tuple[tuple[int, int, int], ...] | None:
-        """Point distance as ``(start, stop, code)`` segments of the flat point, or None.
+    def distance_segments(self) -> tuple[tuple[int, int, str], ...] | None:
+        """The geodesic distance as ``(start, stop, kind)`` blocks of the flat point.
 
-        Used by the DTW kernel to compute the cost matrix inside numba; manifolds that
-        return None have their cost matrix computed by :meth:`pairwise_dist`.
+        ``kind`` is one of :data:`DISTANCE_KINDS`: Euclidean distance, great-circle
+        distance, or the sign-invariant great circle of unit quaternions; the distance of
+        a point is ``sqrt(sum_s d_s^2)`` over the blocks. None when the distance has no
+        such form (SPD): computations that need it (the DTW kernels) then use
+        :meth:`pairwise_dist`. A statement about the geometry only: how a consumer
+        computes these distances is its own business.
         """
         return None
 

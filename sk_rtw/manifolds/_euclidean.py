@@ -7,7 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._backend import safe_norm
-from ._base import SEGMENT_EUCLIDEAN, Manifold, power_of_two_scale
+from ._base import Manifold, power_of_two_scale
 
 
 @dataclass(frozen=True)
@@ -32,8 +32,8 @@ class Euclidean(Manifold):
         return (self.dim,)
 
     @property
-    def numba_segments(self):
-        return ((0, self.dim, SEGMENT_EUCLIDEAN),)
+    def distance_segments(self):
+        return ((0, self.dim, "euclidean"),)
 
     def _exp(self, p, v):
         return p + v

@@ -52,13 +52,13 @@ class Product(Manifold):
         return min(f.injectivity_radius for f in self.factors)
 
     @property
-    def numba_segments(self):
+    def distance_segments(self):
         segments, offset = [], 0
         for factor, size in zip(self.factors, self._sizes, strict=True):
-            own = factor.numba_segments
+            own = factor.distance_segments
             if own is None:
                 return None
-            segments.extend((offset + a, offset + b, code) for a, b, code in own)
+            segments.extend((offset + a, offset + b, kind) for a, b, kind in own)
             offset += size
         return tuple(segments)
 

@@ -9,7 +9,7 @@ import numpy as np
 import torch
 
 from .._backend import inner, safe_norm
-from ._base import SEGMENT_SIGN_INVARIANT_SPHERE, SEGMENT_SPHERE, Manifold
+from ._base import Manifold
 from ._euclidean import _check_dim
 
 # Below this squared norm the closed forms are replaced by their Taylor expansions, so
@@ -88,8 +88,8 @@ class Sphere(Manifold):
         return math.pi
 
     @property
-    def numba_segments(self):
-        return ((0, self.dim + 1, SEGMENT_SPHERE),)
+    def distance_segments(self):
+        return ((0, self.dim + 1, "sphere"),)
 
     def _exp(self, p, v):
         return _sphere_exp(p, v)
@@ -146,8 +146,8 @@ class Quaternion(Sphere):
         return math.pi / 2
 
     @property
-    def numba_segments(self):
-        return ((0, 4, SEGMENT_SIGN_INVARIANT_SPHERE),)
+    def distance_segments(self):
+        return ((0, 4, "sign-invariant sphere"),)
 
     def __repr__(self) -> str:
         return "Quaternion()"
