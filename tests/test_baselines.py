@@ -21,6 +21,7 @@ from sk_rtw.baselines import (
 from sk_rtw.baselines._result import grouped_mean
 from sk_rtw.dtw import dtw_path
 from sk_rtw.manifolds import SPD, Euclidean, Quaternion, Sphere
+from sk_rtw.utils import to_aeon
 
 from .test_dtw import random_walk
 
@@ -183,7 +184,7 @@ def test_dba_matches_aeon_petitjean_on_euclidean_data(rng):
     X = rng.standard_normal((6, 30)).cumsum(1)
     init = X[2]
     expected = elastic_barycenter_average(
-        X[:, None, :], distance="dtw", max_iters=3, tol=0.0, init_barycenter=init[None]
+        to_aeon(X), distance="dtw", max_iters=3, tol=0.0, init_barycenter=init[None]
     )
     result = dba_average(X, n_iter=3, init=init, tol=0.0)
     np.testing.assert_allclose(result.mean[:, 0], expected.ravel(), rtol=1e-10)

@@ -18,8 +18,10 @@ pytestmark = pytest.mark.skipif(
 def load(name: str, split: str):
     from aeon.datasets import load_classification
 
+    from sk_rtw.utils import from_aeon
+
     X, y = load_classification(name, split=split, extract_path=str(UCR_DIR))
-    return X[:, 0, :], y
+    return from_aeon(X), y
 
 
 GUNPOINT_LIMIT = (

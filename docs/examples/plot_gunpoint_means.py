@@ -15,9 +15,10 @@ from aeon.datasets import load_classification
 
 from sk_rtw import align, metrics
 from sk_rtw.baselines import dba_average
+from sk_rtw.utils import from_aeon
 
-X, y = load_classification("GunPoint", split="train")
-series = X[y == "1", 0]  # (n, T): univariate, time-major
+X, y = load_classification("GunPoint", split="train")  # aeon: (n, 1, T), channels first
+series = from_aeon(X)[y == "1"]  # (n, T): univariate, time-major
 print(series.shape)
 
 rtw = align(series, output_length=300, n_epochs=64, random_state=0)

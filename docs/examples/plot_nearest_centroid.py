@@ -14,10 +14,11 @@ from aeon.datasets import load_classification
 from sklearn.metrics import ConfusionMatrixDisplay, accuracy_score
 
 from sk_rtw import RTWNearestCentroid
+from sk_rtw.utils import from_aeon
 
 X_train, y_train = load_classification("ItalyPowerDemand", split="train")
 X_test, y_test = load_classification("ItalyPowerDemand", split="test")
-X_train, X_test = X_train[:, 0], X_test[:, 0]  # time-major univariate series
+X_train, X_test = from_aeon(X_train), from_aeon(X_test)  # (n, 1, T) -> (n, T)
 
 clf = RTWNearestCentroid(n_epochs=64, random_state=0).fit(X_train, y_train)
 y_pred = clf.predict(X_test)
