@@ -102,8 +102,9 @@ class RTWKMeans(ClusterMixin, TransformerMixin, BaseEstimator):
     >>> X = np.stack([np.sin(2 * np.pi * t ** p) for p in (0.8, 1.0, 1.2)]
     ...              + [np.cos(2 * np.pi * t ** p) for p in (0.8, 1.0, 1.2)])
     >>> km = RTWKMeans(n_clusters=2, method="dba", random_state=0).fit(X)
-    >>> km.labels_.tolist()
-    [0, 0, 0, 1, 1, 1]
+    >>> labels = km.labels_.tolist()  # cluster numbers are arbitrary: compare groupings
+    >>> labels[:3] == [labels[0]] * 3 and labels[3:] == [labels[3]] * 3 != labels[:3]
+    True
     """
 
     def __init__(
