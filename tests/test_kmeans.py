@@ -166,3 +166,21 @@ def test_n_centroids_is_searchable_and_validated():
         RTWNearestCentroid(method="dba", n_centroids=0).fit(X, y)
     few = RTWNearestCentroid(method="dba", n_centroids=10).fit(X, y)  # capped per class
     assert len(few.means_) == 18
+
+
+def test_centroids_per_class_use_the_classifiers_engine_settings():
+    X, y = three_shapes()
+    clf = RTWNearestCentroid(
+        n_centroids=2, n_epochs=2, hidden_size=8, learning_rate=0.05, warp_start="identity"
+    ).fit(X, y)
+    params = clf.clusterings_[0].averager_params
+    assert params["hidden_size"] == 8 and params["learning_rate"] == 0.05
+    assert params["warp_start"] == "identity"
+    assert "temperature" not in params and "n_centroids" not in params
+    assert clf.clusterings_[0].n_epochs == 2
+
+
+def test_averager_params_must_be_a_dict():
+    X, _ = three_shapes()
+    with pytest.raises(TypeError, match="averager_params"):
+        RTWKMeans(2, method="dba", averager_params=[("hidden_size", 8)]).fit(X)

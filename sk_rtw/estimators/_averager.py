@@ -92,6 +92,9 @@ class RTWAverager(TransformerMixin, BaseEstimator):
     alignments_ : list of Alignment or MultipleAlignment
         Per class: aligned series, warps and, for the engine's methods, loss history and
         configuration.
+    centroid_classes_ : ndarray of shape (n_classes,)
+        Class index of every entry of ``means_`` (``arange(n_classes)``; the classifier's
+        ``n_centroids`` makes it longer).
     method_ : str
         The averaging method used.
     manifold_ : Manifold
@@ -187,7 +190,8 @@ class RTWAverager(TransformerMixin, BaseEstimator):
             )
         return method.lower()
 
-    def _fit_means(self, X, y, require_two_classes):
+    def _fit_means(self, X, y, require_two_classes, n_centroids: int = 1):
+        """Validate, then fit ``n_centroids`` means per class (k-means above 1)."""
         method = self._resolve_method()
         check_preset(self.preset)
         check_random_state_value(self.random_state)
@@ -212,21 +216,30 @@ class RTWAverager(TransformerMixin, BaseEstimator):
             )
         seeds = check_random_state(self.random_state).randint(2**31 - 1, size=len(classes))
         members = [np.flatnonzero(codes == k) for k in range(len(classes))]
+        fit_one = self._fit_class if n_centroids == 1 else self._cluster_class
         jobs = (
-            delayed(self._fit_class)(
-                collection.subset(idx), method, output_length, int(seed), label
+            delayed(fit_one)(
+                collection.subset(idx), method, output_length, int(seed), label, n_centroids
             )
             for idx, seed, label in zip(members, seeds, classes, strict=True)
         )
         if self.n_jobs in (None, 1) or len(classes) == 1:
-            alignments = [fn(*args, **kwargs) for fn, args, kwargs in jobs]
+            fitted = [fn(*args, **kwargs) for fn, args, kwargs in jobs]
         else:
-            alignments = Parallel(n_jobs=self.n_jobs)(jobs)
+            fitted = Parallel(n_jobs=self.n_jobs)(jobs)
         self.classes_ = classes
         self.method_ = method
         self.manifold_ = collection.manifold
-        self.alignments_ = alignments
-        means = [a.mean for a in alignments]
+        if n_centroids == 1:
+            self.alignments_ = fitted
+            per_class = [[a.mean] for a in fitted]
+        else:
+            self.clusterings_ = fitted
+            per_class = [list(kmeans.cluster_centers_) for kmeans in fitted]
+        means = [m for class_means in per_class for m in class_means]
+        self.centroid_classes_ = np.repeat(
+            np.arange(len(classes)), [len(class_means) for class_means in per_class]
+        )
         same_length = len({len(m) for m in means}) == 1
         self.means_ = np.stack(means) if same_length else means
         if collection.equal_length and collection.manifold.point_shape == (1,):
@@ -245,8 +258,43 @@ class RTWAverager(TransformerMixin, BaseEstimator):
             options["tangent_refinements"] = self.tangent_refinements
         return options
 
+    def _cluster_class(
+        self, collection: SeriesCollection, method: str, output_length: int, seed: int, label,
+        n_centroids: int,
+    ):  # fmt: skip
+        """k-means within one class, centres by this estimator's averaging settings."""
+        from ._kmeans import RTWKMeans
+
+        shared = ("manifold", "method", "output_length", "n_epochs", "preset", "dtw_window",
+                  "n_jobs", "random_state", "device", "verbose")  # fmt: skip
+        averager_params = {
+            name: getattr(self, name)
+            for name in RTWAverager._get_param_names()
+            if name not in shared
+        }
+        return RTWKMeans(
+            n_clusters=min(n_centroids, collection.n_series),
+            method=method,
+            manifold=collection.manifold,
+            output_length=output_length,
+            n_epochs=self.n_epochs,
+            preset=self.preset,
+            dtw_window=self.dtw_window,
+            n_jobs=self.n_jobs,
+            random_state=seed,
+            device=self.device,
+            verbose=self.verbose,
+            averager_params=averager_params,
+        ).fit(collection)
+
     def _fit_class(
-        self, collection: SeriesCollection, method: str, output_length: int, seed: int, label
+        self,
+        collection: SeriesCollection,
+        method: str,
+        output_length: int,
+        seed: int,
+        label,
+        n_centroids: int = 1,
     ):
         start = time.perf_counter()
         result: MultipleAlignment | Alignment

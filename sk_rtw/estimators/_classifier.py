@@ -10,12 +10,10 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 from scipy.special import log_softmax, softmax
 from sklearn.base import ClassifierMixin
-from sklearn.utils import check_random_state
 from sklearn.utils.validation import check_is_fitted
 
-from .._random import check_random_state_value
+from ..align._config import check_positive
 from ..manifolds import Manifold
-from ..utils import check_series_collection
 from ._averager import RTWAverager, _check_labels, _encode
 
 
@@ -88,6 +86,9 @@ mean_iterations, dtw_window, n_jobs, random_state, device, verbose
         Class index of every entry of ``means_`` (``means_`` holds all centroids when
         ``n_centroids > 1``; ``transform`` returns the distance to the nearest centroid of
         each class).
+    clusterings_ : list of RTWKMeans
+        With ``n_centroids > 1``, the k-means fit of every class (``alignments_`` is then
+        not set).
 
     Examples
     --------
@@ -134,17 +135,8 @@ mean_iterations, dtw_window, n_jobs, random_state, device, verbose
         self.n_centroids = n_centroids
 
     def _check_temperature(self) -> None:
-        t = self.temperature
-        if isinstance(t, str):
-            if t != "auto":
-                raise ValueError(f'temperature must be a positive number or "auto", got {t!r}')
-            return
-        if (
-            isinstance(t, bool)
-            or not isinstance(t, (int, float, np.number))
-            or not (math.isfinite(t) and t > 0)
-        ):
-            raise ValueError(f'temperature must be a positive number or "auto", got {t!r}')
+        if not (isinstance(self.temperature, str) and self.temperature == "auto"):
+            check_positive('temperature (a positive number or "auto")', self.temperature)
 
     def fit(self, X: Any, y: Any = None):
         """Learn one mean per class (and the probability temperature).
@@ -168,11 +160,7 @@ mean_iterations, dtw_window, n_jobs, random_state, device, verbose
         k = self.n_centroids
         if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
             raise ValueError(f"n_centroids must be an integer >= 1, got {k!r}")
-        if k == 1:
-            self._fit_means(X, y, require_two_classes=True)
-            self.centroid_classes_ = np.arange(len(self.classes_))
-        else:
-            self._fit_centroids(X, y, int(k))
+        self._fit_means(X, y, require_two_classes=True, n_centroids=int(k))
         if self.temperature == "auto":
             distances = self.transform(X)
             _, codes = _encode(_check_labels(y, len(distances), True))
@@ -180,49 +168,6 @@ mean_iterations, dtw_window, n_jobs, random_state, device, verbose
         else:
             self.temperature_ = float(self.temperature)
         return self
-
-    def _fit_centroids(self, X: Any, y: Any, k: int) -> None:
-        """k-means within every class; ``means_`` holds all centroids."""
-        from ._kmeans import RTWKMeans
-
-        method = self._resolve_method()
-        check_random_state_value(self.random_state)
-        collection = check_series_collection(X, self.manifold)
-        classes, codes = _encode(_check_labels(y, collection.n_series, True))
-        if len(classes) < 2:
-            raise ValueError(
-                f"{type(self).__name__} needs at least 2 classes in y; got {len(classes)} "
-                f"class ({classes.tolist()})"
-            )
-        seeds = check_random_state(self.random_state).randint(2**31 - 1, size=len(classes))
-        centroids, owners, clusterings = [], [], []
-        for c, seed in enumerate(seeds):
-            members = collection.subset(np.flatnonzero(codes == c))
-            kmeans = RTWKMeans(
-                n_clusters=min(k, members.n_series),
-                method=method,
-                manifold=collection.manifold,
-                output_length=self.output_length,
-                n_epochs=self.n_epochs,
-                preset=self.preset,
-                dtw_window=self.dtw_window,
-                n_jobs=self.n_jobs,
-                random_state=int(seed),
-                device=self.device,
-                verbose=self.verbose,
-            ).fit(members)
-            centroids += list(kmeans.cluster_centers_)
-            owners += [c] * len(kmeans.cluster_centers_)
-            clusterings.append(kmeans)
-        self.classes_ = classes
-        self.method_ = method
-        self.manifold_ = collection.manifold
-        self.clusterings_ = clusterings
-        same_length = len({len(m) for m in centroids}) == 1
-        self.means_ = np.stack(centroids) if same_length else centroids
-        self.centroid_classes_ = np.asarray(owners)
-        if collection.equal_length and collection.manifold.point_shape == (1,):
-            self.n_features_in_ = collection.max_length
 
     def transform(self, X: Any) -> np.ndarray:
         """Manifold-DTW distance of every series to every class (its nearest centroid).

@@ -13,26 +13,11 @@ from sklearn.utils.validation import check_is_fitted
 
 from .._numba import check_n_jobs
 from .._random import check_random_state_value
+from ..align._config import check_int, check_positive
 from ..dtw import check_window, dtw_pairwise_distance
 from ..manifolds import Manifold
 from ..utils import SeriesCollection, check_series_collection
 from ._averager import ESTIMATOR_METHODS, RTWAverager
-
-
-def _check_count(name: str, value: Any, minimum: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:
-        raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
-    return int(value)
-
-
-def _check_tol(tol: Any) -> float:
-    if (
-        isinstance(tol, bool)
-        or not isinstance(tol, (int, float, np.number))
-        or not (np.isfinite(tol) and tol >= 0)
-    ):
-        raise ValueError(f"tol must be a non-negative number, got {tol!r}")
-    return float(tol)
 
 
 class RTWKMeans(ClusterMixin, TransformerMixin, BaseEstimator):
@@ -79,6 +64,9 @@ class RTWKMeans(ClusterMixin, TransformerMixin, BaseEstimator):
         Torch device of the centre fits.
     verbose : int, default=0
         1: a line per iteration (inertia, changed assignments, time); 2: also per centre.
+    averager_params : dict, optional
+        Further :class:`RTWAverager` parameters of the centre fits (``learning_rate``,
+        ``hidden_size``, ``warp_start``, ...).
 
     Attributes
     ----------
@@ -123,6 +111,7 @@ class RTWKMeans(ClusterMixin, TransformerMixin, BaseEstimator):
         random_state: Any = None,
         device: str = "cpu",
         verbose: int = 0,
+        averager_params: dict[str, Any] | None = None,
     ):
         self.n_clusters = n_clusters
         self.method = method
@@ -138,13 +127,18 @@ class RTWKMeans(ClusterMixin, TransformerMixin, BaseEstimator):
         self.random_state = random_state
         self.device = device
         self.verbose = verbose
+        self.averager_params = averager_params
 
     # ------------------------------------------------------------------ fit
     def _check_params(self) -> None:
-        _check_count("n_clusters", self.n_clusters, 1)
-        _check_count("n_init", self.n_init, 1)
-        _check_count("max_iter", self.max_iter, 1)
-        _check_tol(self.tol)
+        check_int("n_clusters", self.n_clusters, 1)
+        check_int("n_init", self.n_init, 1)
+        check_int("max_iter", self.max_iter, 1)
+        check_positive("tol", self.tol, allow_zero=True)
+        if self.averager_params is not None and not isinstance(self.averager_params, dict):
+            raise TypeError(
+                f"averager_params must be a dict or None, got {type(self.averager_params)}"
+            )
         if not isinstance(self.method, str) or self.method.lower() not in ESTIMATOR_METHODS:
             raise ValueError(f"method must be one of {ESTIMATOR_METHODS}, got {self.method!r}")
         check_random_state_value(self.random_state)
@@ -216,6 +210,7 @@ class RTWKMeans(ClusterMixin, TransformerMixin, BaseEstimator):
 
     def _average(self, collection: SeriesCollection, labels: np.ndarray, seed: int):
         averager = RTWAverager(
+            **(self.averager_params or {}),
             manifold=collection.manifold,
             method=self.method.lower(),
             preset=self.preset,
