@@ -1,17 +1,12 @@
-"""numba's threading: the workqueue layer, and one lock around this package's launches.
+"""One lock around this package's multi-threaded numba launches, and the n_jobs rule.
 
-numba's default OpenMP layer shares the OpenMP runtime that torch's CPU build loads; once
-a numba kernel has run multi-threaded in the process (a DTW with ``n_jobs > 1``, aeon's
-DBA), every later torch operation runs 2 to 6 times slower on a 2-core machine (measured:
-an RTW fit 0.20 s -> 0.36 s, a TTW fit 0.07 s -> 0.40 s). The ``workqueue`` layer has its
-own threads and no such interaction, at the same DTW speed. So, on import, this module
-selects it -- unless ``NUMBA_THREADING_LAYER`` is set or a layer is already running (then
-nothing changes).
-
-The workqueue layer aborts the process if two Python threads launch parallel kernels at
-the same time; :func:`numba_threads` holds a lock around every parallel launch of this
-package, so concurrent calls from threads (joblib's threading backend, dask threads)
-wait for each other instead.
+numba's ``workqueue`` threading layer (the one it falls back to when neither OpenMP nor TBB
+is available) aborts the process if two Python threads launch parallel kernels at the
+same time; :func:`numba_threads` holds a lock around every parallel launch of this
+package, so concurrent calls from threads (joblib's threading backend, dask threads) wait
+for each other instead. The threading layer itself is left as the user or numba chose it:
+importing sk_rtw changes no process-wide setting (:mod:`sk_rtw._threads` sets thread
+counts per call and restores them).
 """
 
 from __future__ import annotations
@@ -26,22 +21,6 @@ import numpy as np
 
 #: Serialises this package's multi-threaded numba launches.
 PARALLEL_LOCK = threading.RLock()
-
-
-def select_threading_layer() -> str | None:
-    """Use numba's workqueue layer unless the user or an earlier launch chose another.
-
-    Returns
-    -------
-    layer : str or None
-        ``"workqueue"`` when it was selected here, None when nothing was changed.
-    """
-    from numba.np.ufunc import parallel
-
-    if "NUMBA_THREADING_LAYER" in os.environ or parallel._is_initialized:
-        return None
-    numba.config.THREADING_LAYER = "workqueue"
-    return "workqueue"
 
 
 def check_n_jobs(n_jobs: Any) -> None:
@@ -79,6 +58,3 @@ def numba_threads(n_jobs: int | None = -1):
             yield
         finally:
             numba.set_num_threads(previous)
-
-
-select_threading_layer()  # on import: before any of this package's kernels runs

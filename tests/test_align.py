@@ -200,7 +200,7 @@ def test_warps_on_knots_interpolate_the_network_between_them():
     at_knots = unit_time(11)
     # at the knot times both are the same function
     np.testing.assert_allclose(
-        knotted.offsets(zhat)[::10].detach().numpy(),
+        knotted.offsets(zhat)[:, ::10].detach().numpy(),
         exact.offsets(at_knots).detach().numpy(),
         atol=1e-14,
     )
@@ -442,10 +442,55 @@ def test_trainer_keeps_the_lowest_loss_parameters():
     weight = torch.nn.Parameter(torch.tensor([3.0]))
     # a loss with its minimum at 1; a large rate makes Adam overshoot and come back
     trainer = Trainer(lambda: (weight - 1.0).abs().sum(), [weight], 30, 1.5)
-    best = trainer.run(lambda done, history: None, 10)
-    history = trainer.history.numpy()
+    (best,) = trainer.run(lambda done, history: None, 10)
+    history = trainer.history[:, 0].numpy()
     assert best == int(np.argmin(history))
     assert abs(float(weight.detach()) - 1.0) == pytest.approx(history[best])
+
+
+def test_trainer_stops_each_group_on_its_own_and_keeps_its_best():
+    """Two groups in one loop: the one whose loss stalls stops early, its best frozen;
+    the other trains on. Each equals the same group trained alone."""
+    start = torch.tensor([[3.0], [3.0]])
+
+    def losses(weight):
+        # group 0 reaches its floor (1) quickly and stalls there; group 1 keeps improving
+        return torch.stack([(weight[0] - 1.0).abs().sum().clamp_min(0.5),
+                            (weight[1] + 50.0).abs().sum()])  # fmt: skip
+
+    def run(groups, n_groups):
+        weight = torch.nn.Parameter(start[: len(groups)].clone())
+
+        def loss_fn():
+            values = losses(torch.cat([weight, start[len(groups) :]]))[:n_groups]
+            return values.sum(), values
+
+        trainer = Trainer(loss_fn, [weight], 200, 0.1, parameter_groups=[groups],
+                          n_groups=n_groups, n_iter_no_change=5, tol=1e-4)  # fmt: skip
+        best = trainer.run(lambda done, history: None, 50)
+        return trainer, best, weight.detach().clone()
+
+    both, best, weight = run(torch.tensor([0, 1]), 2)
+    alone, best_alone, weight_alone = run(torch.tensor([0]), 1)
+    runs = both.epochs_run.numpy()
+    assert runs[0] < runs[1] == 200  # group 0 stopped early, group 1 ran to the end
+    assert runs[0] == alone.epochs_run.numpy()[0] and best[0] == best_alone[0]
+    torch.testing.assert_close(weight[0], weight_alone[0])
+    assert np.isnan(both.history[runs[0] :, 0].numpy()).all()
+
+
+def test_early_stopping_saves_epochs_and_keeps_the_best():
+    data = make_warped_signals("euclidean", 6, 40, 1)
+    full = align(data.signals, n_iter_no_change=None, n_epochs=120, random_state=0)
+    early = align(data.signals, n_iter_no_change=5, tol=1e-2, n_epochs=120, random_state=0)
+    assert full.n_iter == 120 and early.n_iter < 120
+    ran = early.loss_history[: early.n_iter]
+    assert np.isfinite(ran).all() and np.isnan(early.loss_history[early.n_iter :]).all()
+    # the same trajectory as the full run up to the stop
+    np.testing.assert_allclose(ran, full.loss_history[: early.n_iter], rtol=1e-10)
+    assert early.best_epoch == int(np.argmin(ran))
+    with pytest.raises(ValueError, match="n_iter_no_change"):
+        align(data.signals, n_iter_no_change=0)
 
 
 def test_verbose_reports_progress(capsys):
@@ -590,7 +635,82 @@ def test_zero_readout_init_starts_at_the_identity_with_diverse_hidden_units():
     model = NeuralWarps(4, hidden=16, init="zero-readout")
     zhat = unit_time(30)
     np.testing.assert_array_equal(model(zhat).detach().numpy(), zhat.expand(4, -1).numpy())
-    assert model.phi.hidden2.weight.std() > 0
+    assert model.w2.std() > 0
     weights = torch.randn(4, 30, generator=torch.Generator().manual_seed(0))
     (model(zhat) * weights).sum().backward()
-    assert model.phi.readout.weight.grad.abs().sum() > 0
+    assert model.w3.grad.abs().sum() > 0
+
+
+# ------------------------------------------------------------ groups in one batch
+def _groups_data():
+    a = make_warped_signals("sphere", 5, 40, 1).signals
+    b = make_warped_signals("sphere", 3, 30, 2).signals
+    return list(a) + list(b), np.array([0] * 5 + [1] * 3)
+
+
+@pytest.mark.parametrize("method", ["rtw", "ttw", "ntw"])
+def test_groups_in_one_batch_equal_separate_fits(method):
+    from sk_rtw.align._config import resolve_config
+    from sk_rtw.align._engine import align_collection
+    from sk_rtw.utils import check_series_collection
+
+    series, codes = _groups_data()
+    collection = check_series_collection(series, "sphere")
+    config = resolve_config(method, 5, 40, output_length=50, n_epochs=30, method_options={})
+    # align(random_state=s) seeds its one group with the first draw of default_rng(s)
+    seeds = [int(np.random.default_rng(s).integers(2**31 - 1)) for s in (11, 22)]
+    batch = align_collection(collection, codes, seeds, config)
+    for g, seed in enumerate((11, 22)):
+        alone = align(
+            [s for s, c in zip(series, codes, strict=True) if c == g], manifold="sphere",
+            method=method, output_length=50, n_epochs=30, random_state=seed,
+        )  # fmt: skip
+        assert batch[g].n_iter == alone.n_iter and batch[g].best_epoch == alone.best_epoch
+        np.testing.assert_allclose(batch[g].warps, alone.warps, atol=1e-9)
+        np.testing.assert_allclose(batch[g].mean, alone.mean, atol=1e-9)
+        np.testing.assert_allclose(batch[g].loss_history, alone.loss_history, rtol=1e-9)
+
+
+def test_group_mean_is_each_groups_frechet_mean(rng):
+    from sk_rtw.align._layout import GroupLayout
+    from sk_rtw.align._means import converged_group_mean, group_mean
+
+    S2 = Sphere(2)
+    points = S2.random_point((7, 4), random_state=1)
+    points = S2.exp(np.tile(points[:1], (7, 1, 1)), 0.3 * S2.random_tangent(
+        np.tile(points[:1], (7, 1, 1)), random_state=2))  # fmt: skip
+    codes = np.array([1, 0, 1, 1, 0, 2, 1])
+    weights = rng.uniform(0.5, 2.0, (7, 4))
+    layout = GroupLayout.from_codes(codes)
+    got = converged_group_mean(S2, torch.as_tensor(points), layout, torch.as_tensor(weights))
+    for g in range(3):
+        idx = codes == g
+        expected = S2.mean(points[idx], weights[idx])
+        np.testing.assert_allclose(got[g].numpy(), expected, atol=1e-9)
+    # flat: the weighted average, whatever the start
+    E = Euclidean(2)
+    x = torch.as_tensor(rng.standard_normal((7, 4, 2)))
+    flat = group_mean(E, x, layout, torch.as_tensor(weights))
+    for g in range(3):
+        idx = torch.as_tensor(codes == g)
+        w = torch.as_tensor(weights)[idx][..., None]
+        torch.testing.assert_close(flat[g], (w * x[idx]).sum(0) / w.sum(0))
+    # the one differentiated step from a converged start has the exact mean's gradient
+    x.requires_grad_(True)
+    (group_mean(E, x, layout, start=flat.detach(), differentiate="last") ** 2).sum().backward()
+    grad_last = x.grad.clone()
+    x.grad = None
+    (group_mean(E, x, layout, differentiate="all") ** 2).sum().backward()
+    torch.testing.assert_close(grad_last, x.grad)
+
+
+def test_group_layout_sums_and_broadcasts():
+    from sk_rtw.align._layout import GroupLayout
+
+    layout = GroupLayout.from_codes([2, 0, 2, 1, 0])
+    assert layout.sizes.tolist() == [2, 1, 2] and layout.positions.tolist() == [0, 0, 1, 0, 1]
+    values = torch.arange(5.0)
+    assert layout.sum(values).tolist() == [1 + 4, 3, 0 + 2]
+    assert layout.expand(torch.tensor([10.0, 20.0, 30.0])).tolist() == [30, 10, 30, 20, 10]
+    with pytest.raises(ValueError, match="no series"):
+        GroupLayout.from_codes([0, 2])

@@ -10,7 +10,7 @@ from sklearn.utils.estimator_checks import parametrize_with_checks
 
 from sk_rtw import RTWAverager, RTWKMeans, RTWNearestCentroid
 from sk_rtw.datasets import make_warped_signals
-from sk_rtw.estimators._kmeans import _fill_empty
+from sk_rtw.estimators._core import fill_empty as _fill_empty
 from sk_rtw.manifolds import Sphere
 
 from .test_estimators import EXPECTED_FAILURES
@@ -173,11 +173,14 @@ def test_centroids_per_class_use_the_classifiers_engine_settings():
     clf = RTWNearestCentroid(
         n_centroids=2, n_epochs=2, hidden_size=8, learning_rate=0.05, warp_start="identity"
     ).fit(X, y)
-    params = clf.clusterings_[0].averager_params
-    assert params["hidden_size"] == 8 and params["learning_rate"] == 0.05
-    assert params["warp_start"] == "identity"
-    assert "temperature" not in params and "n_centroids" not in params
-    assert clf.clusterings_[0].n_epochs == 2
+    assert len(clf.alignments_) == len(clf.means_) == 6
+    for fit in clf.alignments_:
+        config = fit.config
+        assert config.hidden_size == 8 and config.learning_rate == 0.05
+        assert config.warp_start == "identity" and config.n_epochs == 2
+    # every training series was averaged into a centroid of its own class
+    _, codes = np.unique(y, return_inverse=True)
+    assert np.array_equal(clf.centroid_classes_[clf.assignments_], codes)
 
 
 def test_averager_params_must_be_a_dict():

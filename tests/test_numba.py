@@ -1,4 +1,4 @@
-"""numba's threading layer and the lock around this package's parallel launches."""
+"""Threads: no process-wide change on import, the lock around parallel launches."""
 
 from __future__ import annotations
 
@@ -22,9 +22,37 @@ def run_python(code: str, **env) -> subprocess.CompletedProcess:
     )
 
 
-def test_workqueue_layer_is_selected_and_concurrent_launches_do_not_abort():
-    """Four threads computing DTW (and the parallel sinc kernel) at the same time: the
-    workqueue layer would abort the process without the lock."""
+def test_importing_the_package_changes_no_process_wide_setting():
+    """numba's threading layer and thread count, torch's threads: as before the import."""
+    result = run_python(
+        """
+        import numba, torch
+        before = (numba.config.THREADING_LAYER, numba.get_num_threads(), torch.get_num_threads())
+        import sk_rtw
+        from sk_rtw import RTWNearestCentroid, align
+        after = (numba.config.THREADING_LAYER, numba.get_num_threads(), torch.get_num_threads())
+        print(before == after, before, after)
+        """
+    )
+    assert result.returncode == 0, result.stderr[-2000:]
+    assert result.stdout.split()[0] == "True", result.stdout
+
+
+def test_a_fit_restores_the_callers_thread_counts():
+    import numba
+    import numpy as np
+    import torch
+
+    from sk_rtw import align
+
+    torch_before, numba_before = torch.get_num_threads(), numba.get_num_threads()
+    align(np.random.default_rng(0).standard_normal((3, 20)), n_epochs=2, n_jobs=-1)
+    assert (torch.get_num_threads(), numba.get_num_threads()) == (torch_before, numba_before)
+
+
+def test_concurrent_launches_on_the_workqueue_layer_do_not_abort():
+    """Four threads computing DTW (and the parallel sinc kernel) at the same time: numba's
+    workqueue layer aborts the process without the lock around this package's launches."""
     result = run_python(
         """
         import threading, numba, numpy as np
@@ -50,7 +78,8 @@ def test_workqueue_layer_is_selected_and_concurrent_launches_do_not_abort():
         [t.join() for t in threads]
         assert not errors, errors
         print(numba.threading_layer())
-        """
+        """,
+        NUMBA_THREADING_LAYER="workqueue",
     )
     assert result.returncode == 0, result.stderr[-2000:]
     assert result.stdout.strip().splitlines()[-1] == "workqueue"
@@ -79,3 +108,12 @@ def test_n_jobs_convention(n_jobs, expected):
         assert count == min(os.cpu_count() or 1, numba.config.NUMBA_NUM_THREADS)
     else:
         assert count == min(expected, numba.config.NUMBA_NUM_THREADS)
+
+
+@pytest.mark.parametrize(
+    ("n_jobs", "work", "expected"), [(None, 1e12, 1), (1, 1e12, 1), (2, 1e3, 1), (2, 1e12, 2)]
+)
+def test_threads_follow_n_jobs_and_the_problem_size(n_jobs, work, expected):
+    from sk_rtw._threads import threads_for, usable_cores
+
+    assert threads_for(n_jobs, work) == min(expected, usable_cores())

@@ -1,4 +1,12 @@
-"""The alignment engine: RTW, TTW and NTW as configurations of one optimisation loop."""
+"""The alignment engine: RTW, TTW and NTW as configurations of one optimisation loop.
+
+:func:`align` aligns one collection of series. The estimators average every class of a
+training set, and k-means every cluster, in *one* optimisation:
+:func:`align_collection` takes the stacked series of all groups with the group of each,
+and trains the stacked warp models of all groups at once (the groups share no parameter,
+so each follows the trajectory of a separate fit; each has its own seed, best iterate and
+early stop).
+"""
 
 from __future__ import annotations
 
@@ -11,10 +19,14 @@ import torch
 
 from .._random import check_generator
 from .._resources import available_memory, format_bytes
+from .._threads import limited_threads, threads_for
 from ..manifolds import Manifold
 from ..utils import SeriesCollection, check_series_collection
 from ._config import AlignmentConfig, resolve_config
-from ._loss import monotonicity_penalty, window_loss, window_weights
+from ._density import density_representatives
+from ._layout import GroupLayout
+from ._loss import window_weights
+from ._means import converged_group_mean, group_mean
 from ._sinc import TABLE_BYTES, SincInterpolator
 from ._start import dtw_start
 from ._training import Trainer, progress_printer
@@ -35,12 +47,16 @@ class Alignment:
         Warping functions in [0, 1]: ``aligned[n, z]`` is signal ``n`` at relative
         position ``warps[n, z]`` (0 = first sample, 1 = last sample).
     loss_history : ndarray of shape (n_epochs,)
-        Total loss (alignment loss + penalty) at every epoch.
+        Total loss (alignment loss + penalty) at every epoch; NaN after an early stop.
     best_epoch : int
         Epoch whose parameters are returned (lowest total loss); -1 when nothing was
-        optimised (a single signal).
+        optimised (a single signal, or ``n_epochs=0``).
     manifold : Manifold
     config : AlignmentConfig
+    fit_time : float
+        Seconds the fit took (for a batch of groups: the whole batch).
+    n_iter : int
+        Epochs run (fewer than ``config.n_epochs`` after an early stop).
     """
 
     mean: np.ndarray
@@ -51,28 +67,33 @@ class Alignment:
     manifold: Manifold
     config: AlignmentConfig
     fit_time: float = field(default=0.0)
+    n_iter: int = field(default=0)
 
 
-def _build_warps(config: AlignmentConfig, n_signals: int) -> NeuralWarps | SineWarps:
+def _build_warps(
+    config: AlignmentConfig, layout: GroupLayout, seeds: list[int]
+) -> NeuralWarps | SineWarps:
     if config.warp == "sine":
-        return SineWarps(n_signals, config.n_components)
-    return NeuralWarps(n_signals, config.hidden_size, config.init, config.warp_knots)
+        return SineWarps(layout, config.n_components)
+    return NeuralWarps(layout, config.hidden_size, config.init, config.warp_knots, seeds)
 
 
 class _Problem:
     """Everything one forward pass needs, on the right device."""
 
-    def __init__(self, collection: SeriesCollection, config: AlignmentConfig):
+    def __init__(self, collection: SeriesCollection, layout: GroupLayout, config: AlignmentConfig):
         device = torch.device(config.device)
         self.manifold = collection.manifold
         self.config = config
+        self.layout = layout.to(device)
         self.data = torch.as_tensor(collection.data, dtype=torch.float64, device=device)
         self.lengths = torch.as_tensor(collection.lengths, device=device)
-        self.zhat = unit_time(config.output_length, device=device)
-        self.loss_weights = window_weights(
-            config.output_length, config.loss_window, config.loss_step, device=device
-        )
-        self.mean_iterations = 1 if self.manifold.is_flat else config.mean_iterations
+        z = config.output_length
+        self.zhat = unit_time(z, device=device)
+        self.loss_weights = window_weights(z, config.loss_window, config.loss_step, device=device)
+        sizes = self.layout.sizes.to(torch.float64)
+        #: 1 / (N_g Z) for every series: each group's loss is the paper's mean over its series
+        self.series_weight = 1.0 / (self.layout.expand(sizes) * z)
         self.interpolate = SincInterpolator(
             self.manifold,
             self.data,
@@ -82,6 +103,49 @@ class _Problem:
         )
         #: Starting warps (N, Z) that the learned warps are composed with, or None.
         self.start: torch.Tensor | None = None
+        #: The previous epoch's means (``mean_start="previous"``): the next Gauss–Newton start.
+        self.warm: torch.Tensor | None = None
+
+    def points_and_weights(self, warps: torch.Tensor, aligned: torch.Tensor):
+        """What enters the mean: the aligned points with equal weights, or the stretch
+        representatives with their sample counts (``mean_weights="density"``)."""
+        if self.config.mean_weights == "density":
+            return density_representatives(self.manifold, self.data, self.lengths, warps,
+                                           aligned)  # fmt: skip
+        return aligned, None
+
+    def average(self, warps: torch.Tensor, aligned: torch.Tensor) -> torch.Tensor:
+        """The engine's mean of every group's aligned series (loss and returned mean)."""
+        config = self.config
+        points, weights = self.points_and_weights(warps, aligned)
+        if self.manifold.is_flat:  # exact in one step, from any start
+            return group_mean(self.manifold, points, self.layout, weights)
+        if config.mean_start == "first":
+            return group_mean(self.manifold, points, self.layout, weights,
+                              iterations=config.mean_iterations, differentiate="all")  # fmt: skip
+        if self.warm is None or self.warm.shape[1] != points.shape[1]:
+            return converged_group_mean(self.manifold, points, self.layout, weights)
+        mean = group_mean(self.manifold, points, self.layout, weights, start=self.warm,
+                          iterations=config.mean_iterations, differentiate="last")  # fmt: skip
+        self.warm.copy_(mean.detach())
+        return mean
+
+    def converged_mean(self, warps: torch.Tensor, start: torch.Tensor | None = None):
+        """The converged mean along ``warps`` (no gradient): DTW start and returned mean."""
+        with torch.no_grad():
+            aligned = self.interpolate(warps)
+            points, weights = self.points_and_weights(warps, aligned)
+            return converged_group_mean(self.manifold, points, self.layout, weights,
+                                        start=start)  # fmt: skip
+
+    def initial_warps(self) -> torch.Tensor:
+        identity = self.zhat.expand(self.layout.n_series, -1)
+        return identity if self.start is None else compose_warps(self.start, identity)
+
+    def prepare_mean(self) -> None:
+        """The Gauss–Newton start of the first epoch: the converged mean at the start."""
+        if self.config.mean_start == "previous" and not self.manifold.is_flat:
+            self.warm = self.converged_mean(self.initial_warps()).clone()
 
     def forward(self, model: WarpModel):
         raw = model(self.zhat)
@@ -89,12 +153,14 @@ class _Problem:
         if self.start is not None:
             warps = compose_warps(self.start, warps)
         aligned = self.interpolate(warps)
-        mean = self.manifold.mean(aligned, axis=0, max_iter=self.mean_iterations, tol=0.0)
-        distances = self.manifold._dist(aligned, mean.unsqueeze(0))
-        loss = window_loss(distances, self.loss_weights)
+        mean = self.average(warps, aligned)
+        distances = self.manifold._dist(aligned, self.layout.expand(mean))
+        per_series = (distances @ self.loss_weights) * self.series_weight
         if self.config.penalty > 0:
-            loss = loss + self.config.penalty * monotonicity_penalty(raw)
-        return loss, warps, aligned, mean
+            decrease = torch.relu(raw[:, :-1] - raw[:, 1:]).sum(1)
+            per_series = per_series + self.config.penalty * decrease
+        group_loss = self.layout.sum(per_series)
+        return group_loss.sum(), group_loss, warps, aligned, mean
 
 
 def align(
@@ -111,8 +177,11 @@ def align(
     loss_step: int | None = None,
     penalty: float | None = None,
     warp_start: str | Any = "auto",
+    n_iter_no_change: int | str | None = "auto",
+    tol: float | None = None,
     random_state: Any = None,
     device: str | torch.device = "cpu",
+    n_jobs: int | None = None,
     verbose: bool | int = False,
     **method_options: Any,
 ) -> Alignment:
@@ -167,11 +236,21 @@ def align(
         learned warps are composed with them. An array: your own non-decreasing warps,
         from 0 to 1, at the ``Z`` output times. Default: the preset's (RTW: ``"dtw"``;
         TTW, NTW and the paper preset: ``"identity"``).
+    n_iter_no_change : int, None or "auto", default="auto"
+        Stop when the loss has not improved by more than ``tol`` (relative) for this many
+        epochs in a row, keeping the best iterate; None trains all ``n_epochs``.
+        ``"auto"``: the preset's (20; the paper preset: None).
+    tol : float, optional
+        Relative improvement that counts for ``n_iter_no_change`` (default 1e-4).
     random_state : int, RandomState, Generator or None
         Seeds the network initialisation and the DTW start; equal seeds give identical
         results.
     device : str or torch.device, default="cpu"
         Torch device for the optimisation, e.g. ``"cuda"``. Results are numpy arrays.
+    n_jobs : int, optional
+        Threads of torch and numba during the fit, scikit-learn's convention (None: 1,
+        -1: all cores); more than one only where the problem is large enough to gain from
+        them. The caller's thread settings are restored afterwards.
     verbose : bool or int, default=False
         Print the loss every ``max(1, n_epochs // 10)`` epochs (or every ``verbose``
         epochs when an int > 1).
@@ -224,51 +303,120 @@ def align(
         penalty=penalty,
         device=device,
         warp_start="given" if given_start is not None else warp_start,
+        n_iter_no_change=n_iter_no_change,
+        tol=tol,
         method_options=method_options,
     )
+    seed = int(check_generator(random_state).integers(2**31 - 1))
+    (result,) = align_collection(
+        collection, np.zeros(n_signals, dtype=np.int64), [seed], config,
+        given_start=given_start, n_jobs=n_jobs, verbose=verbose,
+    )  # fmt: skip
+    return result
+
+
+def align_collection(
+    collection: SeriesCollection,
+    codes: Any,
+    seeds: list[int],
+    config: AlignmentConfig,
+    *,
+    given_start: np.ndarray | None = None,
+    n_jobs: int | None = None,
+    verbose: bool | int = False,
+) -> list[Alignment]:
+    """Align every group of a stacked collection in one optimisation.
+
+    Parameters
+    ----------
+    collection : SeriesCollection
+        The series of all groups.
+    codes : array-like of int, shape (N,)
+        Group of every series, ``0..n_groups - 1``.
+    seeds : list of int
+        One seed per group: ``np.random.default_rng(seed)`` draws the group's network seed,
+        then its medoid candidates (as :func:`align` does with ``random_state``).
+    config : AlignmentConfig
+        The resolved configuration shared by every group.
+    given_start : ndarray of shape (N, Z), optional
+        Starting warps (``config.warp_start == "given"``).
+    n_jobs : int, optional
+        Threads for torch and numba during the fit (scikit-learn's convention; None: 1),
+        used only when the problem is large enough to gain from them.
+    verbose : bool or int
+        Loss reports during training (see :func:`align`).
+
+    Returns
+    -------
+    list of Alignment
+        One per group, in group order.
+    """
     check_memory(collection, config)
-    start = time.perf_counter()
-    rng = check_generator(random_state)
-    seed = int(rng.integers(2**31 - 1))
+    start_time = time.perf_counter()
+    layout = GroupLayout.from_codes(codes)
+    if len(seeds) != layout.n_groups:
+        raise ValueError(f"{len(seeds)} seeds for {layout.n_groups} groups")
+    rngs = [np.random.default_rng(int(seed)) for seed in seeds]
+    torch_seeds = [int(rng.integers(2**31 - 1)) for rng in rngs]
     # magnitudes beyond 1e+-100: align in a frame rescaled by a power of two
     scale = collection.manifold.extreme_scale(collection.data)
     if scale is not None:
         collection = SeriesCollection(
             data=collection.data / scale, lengths=collection.lengths, manifold=collection.manifold
         )
-    with torch.random.fork_rng(devices=[]):
-        torch.manual_seed(seed)
-        model = _build_warps(config, n_signals)
-        model.to(config.device)
-    problem = _Problem(collection, config)
-    if config.warp_start == "dtw" and n_signals > 1:
-        given_start = dtw_start(
-            collection,
-            config.output_length,
-            config.dtw_rounds,
-            lambda warps: problem.interpolate(warps.to(problem.data.device)),
-            rng,
-        )
-    if given_start is not None:
-        problem.start = torch.as_tensor(given_start, dtype=torch.float64, device=config.device)
-    history = np.full(config.n_epochs, np.nan)
-    best_epoch = -1
-    trainable = [p for p in model.parameters() if p.requires_grad]
-    if n_signals > 1 and config.n_epochs > 0 and trainable:
-        best_epoch = _optimise(problem, model, history, verbose)
-    with torch.no_grad():
-        _, warps, aligned, mean = problem.forward(model)
-    factor = 1.0 if scale is None else scale
-    return Alignment(
-        mean=collection.manifold.continuous(mean.cpu().numpy() * factor),
-        aligned=collection.manifold.continuous(aligned.cpu().numpy() * factor),
-        warps=warps.cpu().numpy(),
-        loss_history=history,
-        best_epoch=best_epoch,
-        manifold=collection.manifold,
-        config=config,
-        fit_time=time.perf_counter() - start,
+    work = (
+        collection.n_series
+        * config.output_length
+        * collection.data[0, 0].size
+        * (collection.max_length if config.sinc_window is None else 2 * config.sinc_window + 1)
     )
+    with limited_threads(threads_for(n_jobs, work)):
+        model = _build_warps(config, layout, torch_seeds).to(config.device)
+        problem = _Problem(collection, layout, config)
+        if config.warp_start == "dtw" and layout.max_size > 1:
+            given_start = dtw_start(
+                collection,
+                layout,
+                config.output_length,
+                config.dtw_rounds,
+                lambda warps: problem.converged_mean(warps.to(problem.data.device)),
+                rngs,
+                smoothing=config.smoothing,
+                axis=config.start_axis,
+            )
+        if given_start is not None:
+            problem.start = torch.as_tensor(given_start, dtype=torch.float64, device=config.device)
+        problem.prepare_mean()
+        history = np.full((config.n_epochs, layout.n_groups), np.nan)
+        best_epoch = np.full(layout.n_groups, -1)
+        epochs_run = np.zeros(layout.n_groups, dtype=int)
+        trainable = [p for p in model.parameters() if p.requires_grad]
+        if layout.max_size > 1 and config.n_epochs > 0 and trainable:
+            best_epoch, epochs_run = _optimise(problem, model, history, verbose)
+        with torch.no_grad():
+            _, _, warps, aligned, mean = problem.forward(model)
+            mean = problem.converged_mean(warps, start=mean)
+    factor = 1.0 if scale is None else scale
+    manifold = collection.manifold
+    fit_time = time.perf_counter() - start_time
+    mean_np, aligned_np, warps_np = mean.cpu().numpy(), aligned.cpu().numpy(), warps.cpu().numpy()
+    results = []
+    for g in range(layout.n_groups):
+        idx = layout.members(g)
+        results.append(
+            Alignment(
+                mean=manifold.continuous(mean_np[g] * factor),
+                aligned=manifold.continuous(aligned_np[idx] * factor),
+                warps=warps_np[idx],
+                loss_history=history[:, g].copy(),
+                best_epoch=int(best_epoch[g]),
+                manifold=manifold,
+                config=config,
+                fit_time=fit_time,
+                n_iter=int(epochs_run[g]),
+            )
+        )
+    return results
 
 
 def estimated_memory(collection: SeriesCollection, config: AlignmentConfig) -> int:
@@ -282,7 +430,8 @@ def estimated_memory(collection: SeriesCollection, config: AlignmentConfig) -> i
     z = config.output_length
     point = max(1, collection.data[0, 0].size)
     curved = not collection.manifold.is_flat
-    per_point = 8 * (point * (6 + (4 * config.mean_iterations if curved else 0)) + 8)
+    steps = config.mean_iterations if config.mean_start == "first" else 1
+    per_point = 8 * (point * (6 + (4 * steps if curved else 0)) + 8)
     taps = t_max if config.sinc_window is None else 2 * config.sinc_window + 1
     table = min(8 * n_series * t_max * taps * point, TABLE_BYTES)
     times = z if config.warp_knots is None else min(z, config.warp_knots)
@@ -330,17 +479,26 @@ def _check_warps(warps: Any, n_signals: int, output_length: int | None) -> np.nd
 
 def _optimise(
     problem: _Problem, model: WarpModel, history: np.ndarray, verbose: bool | int
-) -> int:
-    """Adam over the warp parameters; loads the best iterate into ``model``."""
+) -> tuple[np.ndarray, np.ndarray]:
+    """Adam over the warp parameters; loads every group's best iterate into ``model``.
+
+    Returns the best epoch and the number of epochs run of every group.
+    """
     config = problem.config
+    parameters = list(model.parameters())
     trainer = Trainer(
-        lambda: problem.forward(model)[0],
-        [p for p in model.parameters() if p.requires_grad],
+        lambda: problem.forward(model)[:2],
+        parameters,
         config.n_epochs,
         config.learning_rate,
+        parameter_groups=model.parameter_groups(),
+        n_groups=problem.layout.n_groups,
+        n_iter_no_change=config.n_iter_no_change,
+        tol=config.tol,
         cuda_graph=config.cuda_graph,
     )
     report, every = progress_printer(config.method, config.n_epochs, verbose)
     best_epoch = trainer.run(report, every)
-    history[:] = trainer.history[: config.n_epochs].cpu().numpy()
-    return best_epoch
+    done = trainer.epochs_done
+    history[:done] = trainer.history[:done].cpu().numpy()
+    return best_epoch, trainer.epochs_run.cpu().numpy()

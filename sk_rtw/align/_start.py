@@ -5,16 +5,21 @@ archive, RTW's loss from the identity stays about twice as high as the loss of w
 off DTW paths (docs: class means). The DTW start:
 
 1. reference: the DTW medoid (squared geodesic costs) of at most
-   :data:`MEDOID_CANDIDATES` series drawn with the fit's random generator;
-2. for every series the DTW path to the reference; the warp at reference sample ``l`` is
-   the mean index of the series samples matched with it, as a relative position in
+   :data:`MEDOID_CANDIDATES` series drawn with the fit's random generator (on copies
+   halved in length where the all-pairs DTW would exceed :data:`MEDOID_CELLS` cells);
+2. for every series the DTW path to the reference (coarse to fine in a band for long
+   pairs, :func:`sk_rtw.dtw._band.multiscale_path`); the warp at reference sample ``l``
+   is the mean index of the series samples matched with it, as a relative position in
    [0, 1], made non-decreasing, with the ends at 0 and 1, and smoothed by a Gaussian of
    :data:`SMOOTHING` samples (monotonicity and ends kept);
-3. centring: the common time axis is reparametrised so that the average warp is the
-   identity (the mean time of the paper's warp basis) and sampled at the ``Z`` output
-   times;
-4. rounds: the Riemannian mean of the series resampled along these warps becomes the next
-   reference; ``rounds`` references in all.
+3. time axis: the common time axis is the reference's (``axis="reference"``, as DBA's)
+   or is reparametrised so that the average warp is the identity (``axis="average"``, the
+   mean time of the paper's warp basis); the warps are sampled at the ``Z`` output times;
+4. rounds: the engine's mean of the series resampled along these warps (at the ``Z``
+   output times) becomes the next reference; ``rounds`` references in all.
+
+Several groups (the classes of an estimator) each get their own reference, rounds and
+centring.
 
 The engine then learns the paper's warps ``phi_n`` (identity plus network on the
 orthonormal basis, with the monotonicity penalty) and uses ``w_n = s_n ∘ phi_n``: a
@@ -28,8 +33,11 @@ from collections.abc import Callable
 import numpy as np
 import torch
 
-from ..dtw import medoid_index, path_indices
+from ..dtw import medoid_index
+from ..dtw._band import halve, multiscale_path
+from ..manifolds import Manifold
 from ..utils import SeriesCollection
+from ._layout import GroupLayout
 
 #: Series among which the first reference (the DTW medoid) is chosen.
 MEDOID_CANDIDATES = 64
@@ -87,6 +95,19 @@ def _smooth_monotone(warp: np.ndarray, sigma: float) -> np.ndarray:
     return np.maximum.accumulate(np.clip(smooth, 0.0, 1.0))
 
 
+#: Time axes of the DTW start: ``"average"`` reparametrises the common axis so that the
+#: average warp is the identity (the mean has the average timing of the series);
+#: ``"reference"`` keeps the time axis of the reference (the medoid), as DBA's mean does.
+START_AXES = ("average", "reference")
+
+
+def reference_warps(warps: np.ndarray, n_points: int) -> np.ndarray:
+    """Warps ``(N, L)`` on the reference's time axis, resampled at ``n_points`` times."""
+    grid = np.linspace(0.0, 1.0, warps.shape[1])
+    times = np.linspace(0.0, 1.0, n_points)
+    return np.stack([np.interp(times, grid, w) for w in warps])
+
+
 def centred_warps(warps: np.ndarray, n_points: int) -> np.ndarray:
     """Warps ``(N, L)`` on the reference's time axis, resampled at ``n_points`` times of
     the axis on which their average is the identity.
@@ -109,46 +130,118 @@ def centred_warps(warps: np.ndarray, n_points: int) -> np.ndarray:
     return np.stack([np.interp(times, grid, w) for w in warps])
 
 
+def coarse(series: np.ndarray, manifold: Manifold, length: int) -> np.ndarray:
+    """``series`` halved by geodesic midpoints until it has at most ``length`` samples."""
+    while len(series) > length:
+        series = halve(series, manifold)
+    return series
+
+
+def reference_medoid(
+    series: list[np.ndarray], manifold: Manifold, rng: np.random.Generator
+) -> np.ndarray:
+    """The first reference: the DTW medoid of (at most :data:`MEDOID_CANDIDATES`) series.
+
+    The all-pairs DTW costs ``N^2 T^2 / 2`` cells (a minute for 12 robot demonstrations of
+    3,000 samples); beyond :data:`MEDOID_CELLS` the medoid is chosen on copies halved by
+    geodesic midpoints until it fits, and the full-length series it designates is
+    returned.
+    """
+    index = np.arange(len(series))
+    if len(series) > MEDOID_CANDIDATES:
+        index = np.sort(rng.choice(len(series), MEDOID_CANDIDATES, replace=False))
+    if len(index) == 1:
+        return series[int(index[0])]
+    length = max(len(series[i]) for i in index)
+    pairs = len(index) * (len(index) - 1) / 2
+    while length > 16 and pairs * length**2 > MEDOID_CELLS:
+        length = (length + 1) // 2
+    small = [coarse(series[i], manifold, length) for i in index]
+    lengths = np.array([len(s) for s in small])
+    data = np.stack(
+        [np.concatenate([s, np.repeat(s[-1:], lengths.max() - len(s), 0)]) for s in small]
+    )
+    collection = SeriesCollection(data=data, lengths=lengths, manifold=manifold)
+    return series[int(index[medoid_index(collection)])]
+
+
+#: DTW cells of the all-pairs medoid search beyond which the series are halved first.
+MEDOID_CELLS = 2e8
+
+
 def dtw_start(
     collection: SeriesCollection,
+    layout: GroupLayout,
     n_points: int,
     rounds: int,
-    resample: Callable[[torch.Tensor], torch.Tensor],
-    rng: np.random.Generator,
+    mean_along: Callable[[torch.Tensor], torch.Tensor],
+    rngs: list[np.random.Generator],
+    smoothing: float | None = None,
+    axis: str = "average",
 ) -> np.ndarray:
     """Starting warps ``(N, n_points)`` from DTW paths (see the module docstring).
 
     Parameters
     ----------
     collection : SeriesCollection
-        The series to align.
+        The series to align (all groups, stacked).
+    layout : GroupLayout
+        Group of every series; each group gets its own reference and centring.
     n_points : int
         Output length ``Z``.
     rounds : int
         References used: the medoid, then the mean of each round.
-    resample : callable
-        Warps (N, Z) tensor -> series resampled along them (N, Z, *point_shape) tensor: the
-        engine's interpolation.
-    rng : numpy.random.Generator
-        Draws the medoid candidates.
+    mean_along : callable
+        Warps (N, L) tensor -> the mean of every group along them (n_groups, L,
+        *point_shape) tensor: the engine's interpolation and mean.
+    rngs : list of numpy.random.Generator
+        One per group; draws the medoid candidates.
+    smoothing : float, optional
+        Gaussian smoothing of the path warps, in reference samples (default
+        :data:`SMOOTHING`).
+    axis : {"average", "reference"}, default="average"
+        Time axis of the returned warps (:data:`START_AXES`).
 
     Returns
     -------
     warps : ndarray of shape (N, n_points)
     """
+    if axis not in START_AXES:
+        raise ValueError(f"axis must be one of {START_AXES}, got {axis!r}")
+    on_axis = centred_warps if axis == "average" else reference_warps
     manifold = collection.manifold
-    n_series = collection.n_series
-    candidates = None
-    if n_series > MEDOID_CANDIDATES:
-        candidates = np.sort(rng.choice(n_series, MEDOID_CANDIDATES, replace=False))
-    reference = collection.series(medoid_index(collection, candidates))
-    series = [collection.series(i) for i in range(n_series)]
+    series = [collection.series(i) for i in range(collection.n_series)]
+    members = [layout.members(g) for g in range(layout.n_groups)]
+    references = [
+        reference_medoid([series[i] for i in idx], manifold, rng)
+        for idx, rng in zip(members, rngs, strict=True)
+    ]
+    # later references: the group mean at the output length
+    ref_points = [n_points for _ in members]
+    codes = layout.codes.cpu().numpy()
+    along = [np.empty(0)] * len(series)
     for round_ in range(rounds):
-        paths = [path_indices(reference, s, manifold, squared=True)[0] for s in series]
-        along = [path_warp(p, len(reference), len(s)) for p, s in zip(paths, series, strict=True)]
-        warps = centred_warps(np.stack(along), n_points)
-        if round_ < rounds - 1:
-            with torch.no_grad():
-                aligned = resample(torch.as_tensor(warps))
-                reference = manifold.mean(aligned, axis=0, max_iter=8, tol=0.0).cpu().numpy()
+        previous = list(along)
+        for i, s in enumerate(series):
+            reference = references[codes[i]]
+            path, _ = multiscale_path(reference, s, manifold, squared=True)
+            along[i] = path_warp(path, len(reference), len(s), smoothing)
+        if round_ == rounds - 1 or (
+            round_ > 1 and all(np.array_equal(a, b) for a, b in zip(along, previous, strict=True))
+        ):  # a fixed point: the next reference would be this one again
+            break
+        length = max(ref_points)
+        warps = np.empty((len(series), length))
+        for g, idx in enumerate(members):
+            group = on_axis(np.stack([along[i] for i in idx]), ref_points[g])
+            # groups with shorter references: pad with the end value (ignored below)
+            warps[idx] = np.pad(group, ((0, 0), (0, length - ref_points[g])), mode="edge")
+        means = mean_along(torch.as_tensor(warps)).cpu().numpy()
+        references = [means[g, : ref_points[g]] for g in range(layout.n_groups)]
+    warps = np.empty((len(series), n_points))
+    for idx in members:
+        if len(idx) == 1:  # a series alone: its mean is itself, its warp the identity
+            warps[idx] = np.linspace(0.0, 1.0, n_points)
+        else:
+            warps[idx] = on_axis(np.stack([along[i] for i in idx]), n_points)
     return warps

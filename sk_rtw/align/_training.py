@@ -1,19 +1,27 @@
-"""The optimisation loop: Adam over the warp parameters, best iterate kept.
+"""The optimisation loop: Adam over the warp parameters, each group's best iterate kept.
 
-One epoch is: forward pass to the loss, backward pass, bookkeeping (loss history; the
-parameters of the lowest loss so far are copied aside *before* the Adam step changes
-them), Adam step. On a GPU everything after the forward pass stays on the device: the
-bookkeeping uses ``torch.where`` rather than Python decisions on the loss value, so an
-epoch needs no host-device synchronisation. On a CPU reading the loss is free, and the
-parameters are copied only when the loss improves.
+The parameters of several independent groups (the classes of an estimator) are trained in
+one loop. The loss function returns the total loss (whose gradient drives Adam) and the
+loss of every group; because the groups share no parameter and Adam is elementwise, each
+group follows exactly the trajectory of a separate fit. Per group the loop keeps
+
+* the lowest loss so far, its epoch and a copy of the group's parameters at that epoch
+  (copied *before* the Adam step changes them);
+* an early-stopping counter (``n_iter_no_change``, ``tol``, as scikit-learn's
+  ``MLPRegressor``): an epoch counts as no improvement unless its loss is below the best
+  loss by more than ``tol`` times its size; after ``n_iter_no_change`` such epochs in a
+  row the group stops: its best iterate is frozen. The loop ends when every group has
+  stopped or after ``n_epochs``.
+
+All bookkeeping is tensor operations (``torch.where``), so an epoch needs no host-device
+synchronisation on a GPU; on a CPU the stop flags are read every epoch, on CUDA every
+``report_every`` epochs.
 
 With ``cuda_graph=True`` on a CUDA device the whole epoch is captured once in a CUDA
 graph and replayed (``torch.cuda.CUDAGraph``): a small alignment problem is otherwise bound
 by the launch cost of several hundred small kernels per epoch. Capture is tried after a
-few eager warm-up epochs; if an operation cannot be captured (some devices' eigensolvers
-synchronise), the remaining epochs run eagerly with a warning. On CUDA, losses are read
-back every ``report_every`` epochs (progress, non-finite check), not every epoch.
-Graph capture is opt-in: it has not yet been checked on a GPU
+few eager warm-up epochs; if an operation cannot be captured, the remaining epochs run
+eagerly with a warning. Graph capture is opt-in: it has not yet been checked on a GPU
 (``benchmarks/check_cuda.py`` does that check).
 """
 
@@ -22,7 +30,7 @@ from __future__ import annotations
 import math
 import sys
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 import numpy as np
 import torch
@@ -32,32 +40,49 @@ WARMUP_EPOCHS = 3
 
 
 class Trainer:
-    """Adam on ``parameters`` minimising ``loss_fn()``; keeps the best parameters.
+    """Adam on ``parameters`` minimising ``loss_fn()``; keeps every group's best parameters.
 
     Parameters
     ----------
     loss_fn : callable
-        Returns the scalar loss tensor of the current parameters.
+        Returns the scalar total loss, or a pair ``(total, group_losses)`` with the loss
+        of each of ``n_groups`` groups (shape ``(n_groups,)``).
     parameters : list of torch.Tensor
         Trainable parameters (updated in place).
     n_epochs : int
     learning_rate : float
+    parameter_groups : list of torch.Tensor, optional
+        For every parameter, the group of each index along its leading axis (default:
+        everything belongs to group 0).
+    n_groups : int, default=1
+    n_iter_no_change : int or None, default=None
+        Stop a group after this many epochs without an improvement larger than ``tol``
+        (None: never stop early).
+    tol : float, default=1e-4
+        Relative improvement that counts.
     cuda_graph : bool, default=False
         Capture the epoch in a CUDA graph and replay it (CUDA devices only).
     """
 
     def __init__(
         self,
-        loss_fn: Callable[[], torch.Tensor],
-        parameters: list[torch.Tensor],
+        loss_fn: Callable[[], torch.Tensor | tuple[torch.Tensor, torch.Tensor]],
+        parameters: Sequence[torch.Tensor],
         n_epochs: int,
         learning_rate: float,
+        parameter_groups: Sequence[torch.Tensor] | None = None,
+        n_groups: int = 1,
+        n_iter_no_change: int | None = None,
+        tol: float = 1e-4,
         cuda_graph: bool = False,
     ):
         self.loss_fn = loss_fn
         self.cuda_graph = cuda_graph
-        self.parameters = parameters
+        self.parameters = list(parameters)
         self.n_epochs = n_epochs
+        self.n_groups = n_groups
+        self.n_iter_no_change = n_iter_no_change
+        self.tol = float(tol)
         device = parameters[0].device
         self.device = device
         self.cuda = device.type == "cuda"
@@ -66,52 +91,79 @@ class Trainer:
             parameters, lr=learning_rate, fused=True, capturable=self.cuda
         )
         dtype = parameters[0].dtype
+        if parameter_groups is None:
+            parameter_groups = [torch.zeros(p.shape[0] if p.ndim else 1, dtype=torch.long)
+                                for p in parameters]  # fmt: skip
+        self._shapes = [
+            groups.to(device).view(-1, *([1] * max(p.ndim - 1, 0)))
+            for groups, p in zip(parameter_groups, parameters, strict=True)
+        ]
         self.best = [p.detach().clone() for p in parameters]
-        self.best_loss = torch.full((), math.inf, dtype=dtype, device=device)
-        self.best_epoch = torch.full((), -1, dtype=torch.long, device=device)
-        self.history = torch.full((max(1, n_epochs),), math.nan, dtype=dtype, device=device)
+        self.best_loss = torch.full((n_groups,), math.inf, dtype=dtype, device=device)
+        self.best_epoch = torch.full((n_groups,), -1, dtype=torch.long, device=device)
+        self.active = torch.ones(n_groups, dtype=torch.bool, device=device)
+        self.stalled = torch.zeros(n_groups, dtype=torch.long, device=device)
+        self.epochs_run = torch.zeros(n_groups, dtype=torch.long, device=device)
+        self.history = torch.full(
+            (max(1, n_epochs), n_groups), math.nan, dtype=dtype, device=device
+        )
         self.epoch = torch.zeros(1, dtype=torch.long, device=device)
+        self._limit = n_iter_no_change if n_iter_no_change is not None else max(1, n_epochs) + 1
+
+    def _losses(self) -> tuple[torch.Tensor, torch.Tensor]:
+        out = self.loss_fn()
+        if isinstance(out, tuple):
+            return out
+        return out, out.reshape(1)
 
     def step(self, zero_grad: bool = True) -> None:
-        """One epoch (on CUDA with no host-device synchronisation)."""
+        """One epoch (no host-device synchronisation)."""
         if zero_grad:
             self.optimiser.zero_grad(set_to_none=True)
-        loss = self.loss_fn()
-        loss.backward()
+        total, groups = self._losses()
+        total.backward()
         with torch.no_grad():
-            value = loss.detach()
-            if self.cuda:
-                better = value < self.best_loss  # False for NaN
-                self.best_loss.copy_(torch.where(better, value, self.best_loss))
-                self.best_epoch.copy_(torch.where(better, self.epoch[0], self.best_epoch))
-                for kept, current in zip(self.best, self.parameters, strict=True):
-                    kept.copy_(torch.where(better, current, kept))
-            elif value < self.best_loss:  # host memory: reading the loss is free
-                self.best_loss.copy_(value)
-                self.best_epoch.copy_(self.epoch[0])
-                torch._foreach_copy_(self.best, self.parameters)
-            self.history.index_copy_(0, self.epoch, value.reshape(1))
+            value = groups.detach()
+            active = self.active
+            better = (value < self.best_loss) & active  # False for NaN
+            threshold = self.best_loss - self.tol * self.best_loss.abs()
+            significant = (value < threshold) | torch.isinf(self.best_loss)
+            self.best_loss.copy_(torch.where(better, value, self.best_loss))
+            self.best_epoch.copy_(torch.where(better, self.epoch, self.best_epoch))
+            for kept, current, shape in zip(self.best, self.parameters, self._shapes,
+                                            strict=True):  # fmt: skip
+                kept.copy_(torch.where(better[shape], current, kept))
+            self.history.index_copy_(
+                0, self.epoch, torch.where(active, value, math.nan).unsqueeze(0)
+            )
+            self.epochs_run.add_(active.long())
+            self.stalled.copy_(torch.where(significant, 0, self.stalled + 1))
+            self.active.copy_(active & (self.stalled < self._limit))
             self.epoch += 1
         self.optimiser.step()
 
-    def run(self, report: Callable[[int, np.ndarray], None], report_every: int) -> int:
-        """All epochs; loads the best parameters and returns the best epoch.
+    def run(self, report: Callable[[int, np.ndarray], None], report_every: int) -> np.ndarray:
+        """All epochs (or until every group stopped); loads each group's best parameters.
 
         ``report(done, history)`` is called every ``report_every`` epochs and at the end
-        with the number of epochs done and the losses so far.
+        with the number of epochs done and the losses so far (``(done, n_groups)``).
+
+        Returns
+        -------
+        best_epoch : ndarray of int, shape (n_groups,)
 
         Raises
         ------
         FloatingPointError
-            As soon as a report finds a non-finite loss.
+            As soon as a check finds a non-finite loss.
         """
         done, graph = 0, None
         if self.cuda and self.cuda_graph:
             done = self._warm_up(report, report_every)
             graph = self._capture() if done < self.n_epochs else None
-        # on a CPU reading the loss costs nothing: check every epoch
+        # on a CPU reading the flags costs nothing: check every epoch
         check_every = report_every if self.cuda else 1
-        while done < self.n_epochs:
+        while done < self.n_epochs and bool(self.active.any()):
             block = min(check_every, self.n_epochs - done)
             for _ in range(block):
                 if graph is not None:
@@ -119,12 +171,14 @@ class Trainer:
                 else:
                     self.step()
             done += block
-            announce = done % report_every == 0 or done == self.n_epochs
+            stopped = not bool(self.active.any())
+            announce = done % report_every == 0 or done == self.n_epochs or stopped
             self._check(done, report if announce else None)
+        self.epochs_done = done
         with torch.no_grad():
             for current, kept in zip(self.parameters, self.best, strict=True):
                 current.copy_(kept)
-        return int(self.best_epoch)
+        return self.best_epoch.cpu().numpy()
 
     # ------------------------------------------------------------------ cuda
     def _warm_up(self, report, report_every: int) -> int:
@@ -161,12 +215,16 @@ class Trainer:
     def _check(self, done: int, report) -> None:
         """Raise on a non-finite loss among the first ``done``; then ``report`` if given."""
         history = self.history[:done].cpu().numpy()
-        bad = np.flatnonzero(~np.isfinite(history))
-        if bad.size:
-            raise FloatingPointError(
-                f"the alignment loss became {history[bad[0]]} at epoch {bad[0]}; lower "
-                "learning_rate or check the data scale"
-            )
+        epochs_run = self.epochs_run.cpu().numpy()
+        for g in range(self.n_groups):
+            values = history[: epochs_run[g], g]
+            bad = np.flatnonzero(~np.isfinite(values))
+            if bad.size:
+                where = f" of group {g}" if self.n_groups > 1 else ""
+                raise FloatingPointError(
+                    f"the alignment loss{where} became {values[bad[0]]} at epoch {bad[0]}; "
+                    "lower learning_rate or check the data scale"
+                )
         if report is not None:
             report(done, history)
 
@@ -180,10 +238,14 @@ def progress_printer(method: str, n_epochs: int, verbose: bool | int):
     def report(done: int, history: np.ndarray) -> None:
         if not verbose:
             return
-        best = int(np.argmin(history))
+        history = np.atleast_2d(history.T).T  # (done, n_groups)
+        total = np.nansum(history, axis=1)
+        running = int(np.isfinite(history[-1]).sum())
+        best = int(np.argmin(total)) if np.isfinite(total).any() else 0
+        groups = f", {running}/{history.shape[1]} groups running" if history.shape[1] > 1 else ""
         print(
-            f"[{method}] epoch {done:>4}/{n_epochs} loss {history[-1]:.6g} "
-            f"(best {history[best]:.6g} at {best + 1})",
+            f"[{method}] epoch {done:>4}/{n_epochs} loss {total[-1]:.6g} "
+            f"(best {total[best]:.6g} at {best + 1}){groups}",
             file=sys.stderr,
             flush=True,
         )

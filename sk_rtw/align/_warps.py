@@ -6,32 +6,40 @@
   R^N. The basis is the ``Q`` of the QR decomposition of the all-ones column, held as one
   Householder reflector, so applying it costs O(N) rather than O(N^2) per time index.
   Because ``e_2..e_N`` are orthogonal to ``1``, the mean warp is the identity.
-  ``phi_theta`` is the network 1-512-512-(1025)-(N-1): two hidden ReLU layers of 512 and a
-  linear output layer that reads the skip-concatenation ``[h2, h1, zhat]`` (1025 values),
-  i.e. ``263680 + 1025 (N - 1) + (N - 1)`` parameters as in the paper. RTW initialises
-  the weights with Xavier (symmetry breaking), NTW with zeros.
+  ``phi_theta`` is the network 1-H-H-(2H+1)-(N-1): two hidden ReLU layers of width ``H``
+  and a linear output layer that reads the skip-concatenation ``[h2, h1, zhat]``. With the
+  paper's ``H = 512`` that is ``263680 + 1025 (N - 1) + (N - 1)`` parameters. RTW
+  initialises the weights with Xavier (symmetry breaking), NTW with zeros.
 * :class:`SineWarps` (TTW, paper eq. 21): ``w_n = zhat + sum_k a_{n,k} sin(pi k zhat)``
   with the coefficients centred across signals; monotonicity is restored as in the TTW
   reference: values clamped to [0, 1], then every decrease replaced by the previous value
   (a running maximum).
+
+Both hold the warps of several independent groups of series (the classes of an
+estimator) in stacked parameters: group ``g`` of ``N_g`` series has its own network (or
+coefficients), its own basis of R^{N_g} and its own initialisation seed, so the groups
+train exactly as separate fits would (Adam is elementwise). A network's readout is padded
+to the largest group; the padded outputs are masked to zero and never move.
 
 The returned warps are clamped to [0, 1]; ``raw`` warps (before clamping) feed the
 monotonicity penalty.
 
 ``knots``: the network may be evaluated at ``knots`` equally spaced times only and its
 output interpolated linearly to the ``Z`` output times (a ReLU network of one input is
-piecewise linear anyway). The network then costs ``knots / Z`` of its full price, which is
-most of an epoch's work on a CPU; ``None`` evaluates it at every output time (the paper).
+piecewise linear anyway). The network then costs ``knots / Z`` of its full price;
+``None`` evaluates it at every output time (the paper).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from typing import Protocol, runtime_checkable
 
 import torch
 from torch import nn
+
+from ._layout import GroupLayout
 
 #: Network initialisations: Xavier everywhere (RTW), zeros everywhere (NTW), or Xavier
 #: hidden layers with a zero readout (the warps start exactly at the identity while the
@@ -43,8 +51,8 @@ INITS = ("xavier", "zeros", "zero-readout")
 class WarpModel(Protocol):
     """What the engine needs of a warp model (:class:`NeuralWarps`, :class:`SineWarps`).
 
-    A new family of warps is a ``torch.nn.Module`` with these three members; the engine
-    trains its parameters with Adam against the method's loss.
+    A new family of warps is a ``torch.nn.Module`` with these members; the engine trains
+    its parameters with Adam against the method's loss.
     """
 
     def __call__(self, zhat: torch.Tensor) -> torch.Tensor:
@@ -59,10 +67,24 @@ class WarpModel(Protocol):
         """The trainable parameters."""
         ...
 
+    def parameter_groups(self) -> list[torch.Tensor]:
+        """For every parameter (in ``parameters()`` order), the group of each index of its
+        leading axis: what the trainer needs to keep each group's best iterate."""
+        ...
+
 
 def unit_time(n_points: int, dtype=torch.float64, device=None) -> torch.Tensor:
     """``zhat`` = ``(z - 1) / (Z - 1)`` for ``z = 1..Z``, shape (Z,)."""
     return torch.linspace(0.0, 1.0, n_points, dtype=dtype, device=device)
+
+
+def _layout(groups: int | Sequence[int] | GroupLayout) -> GroupLayout:
+    if isinstance(groups, GroupLayout):
+        return groups
+    if isinstance(groups, int):
+        return GroupLayout.single(groups)
+    sizes = [int(s) for s in groups]
+    return GroupLayout.from_codes([g for g, size in enumerate(sizes) for _ in range(size)])
 
 
 class HouseholderBasis(nn.Module):
@@ -92,32 +114,6 @@ class HouseholderBasis(nn.Module):
         return eye - self.scale * torch.outer(self.u, self.u)
 
 
-class SkipMLP(nn.Module):
-    """``phi_theta``: 1 -> 512 -> 512 -> linear readout of ``[h2, h1, zhat]`` (1025)."""
-
-    def __init__(
-        self, n_outputs: int, hidden: int = 512, init: str = "xavier", dtype=torch.float64
-    ):
-        super().__init__()
-        self.hidden1 = nn.Linear(1, hidden, dtype=dtype)
-        self.hidden2 = nn.Linear(hidden, hidden, dtype=dtype)
-        self.readout = nn.Linear(2 * hidden + 1, n_outputs, dtype=dtype)
-        if init not in INITS:
-            raise ValueError(f"init must be one of {INITS}, got {init!r}")
-        for layer in (self.hidden1, self.hidden2, self.readout):
-            if init == "zeros" or (init == "zero-readout" and layer is self.readout):
-                nn.init.zeros_(layer.weight)
-            else:
-                nn.init.xavier_uniform_(layer.weight)
-            nn.init.zeros_(layer.bias)
-
-    def forward(self, zhat: torch.Tensor) -> torch.Tensor:
-        x = zhat.unsqueeze(-1)
-        h1 = torch.relu(self.hidden1(x))
-        h2 = torch.relu(self.hidden2(h1))
-        return self.readout(torch.cat([h2, h1, x], dim=-1))
-
-
 def compose_warps(outer: torch.Tensor, inner: torch.Tensor) -> torch.Tensor:
     """``outer_n(inner_n(z))`` for warps sampled on a uniform grid of [0, 1].
 
@@ -140,6 +136,12 @@ def compose_warps(outer: torch.Tensor, inner: torch.Tensor) -> torch.Tensor:
     return low + (position - left) * (high - low)
 
 
+def _linear_stencil(n_values: int, times: torch.Tensor):
+    position = times * (n_values - 1)
+    left = torch.floor(position).long().clamp(0, n_values - 2)
+    return left, (position - left).to(times.dtype)
+
+
 def resample_linear(values: torch.Tensor, times: torch.Tensor) -> torch.Tensor:
     """Linear interpolation of ``values`` (J, ...) given at J equally spaced times of [0, 1].
 
@@ -154,10 +156,16 @@ def resample_linear(values: torch.Tensor, times: torch.Tensor) -> torch.Tensor:
     -------
     torch.Tensor, shape (Z, ...)
     """
-    position = times * (values.shape[0] - 1)
-    left = torch.floor(position).long().clamp(0, values.shape[0] - 2)
-    weight = (position - left).reshape(-1, *([1] * (values.ndim - 1)))
-    return torch.lerp(values[left], values[left + 1], weight.to(values.dtype))
+    left, weight = _linear_stencil(values.shape[0], times)
+    weight = weight.reshape(-1, *([1] * (values.ndim - 1)))
+    return torch.lerp(values[left], values[left + 1], weight)
+
+
+def _xavier(shape: tuple[int, ...], fan_in: int, fan_out: int, generator) -> torch.Tensor:
+    """Xavier-uniform values (Glorot and Bengio, 2010) drawn from ``generator``."""
+    bound = math.sqrt(6.0 / (fan_in + fan_out)) if fan_in + fan_out else 0.0
+    values = torch.rand(shape, generator=generator, dtype=torch.float64)
+    return (2.0 * values - 1.0) * bound
 
 
 class NeuralWarps(nn.Module):
@@ -165,46 +173,128 @@ class NeuralWarps(nn.Module):
 
     Parameters
     ----------
-    n_signals : int
+    groups : int, sequence of int or GroupLayout
+        Number of series (one group), the size of every group, or the layout of the
+        stacked series.
     hidden : int, default=512
-        Width of the two hidden layers.
-    init : {"xavier", "zeros"}, default="xavier"
+        Width ``H`` of the two hidden layers.
+    init : {"xavier", "zeros", "zero-readout"}, default="xavier"
     knots : int or None, default=None
         Evaluate the network at this many equally spaced times and interpolate linearly
         (None: at every output time).
+    seeds : sequence of int, optional
+        Seed of every group's initialisation (default: drawn from torch's global
+        generator).
     """
 
     def __init__(
         self,
-        n_signals: int,
+        groups: int | Sequence[int] | GroupLayout,
         hidden: int = 512,
         init: str = "xavier",
         knots: int | None = None,
+        seeds: Sequence[int] | None = None,
         dtype=torch.float64,
     ):
         super().__init__()
+        self.mask: torch.Tensor
+        self.u: torch.Tensor
+        self.scale: torch.Tensor
+        self._rows: torch.Tensor
         if knots is not None and knots < 2:
             raise ValueError(f"knots must be None or an integer >= 2, got {knots!r}")
-        self.n_signals = n_signals
+        if init not in INITS:
+            raise ValueError(f"init must be one of {INITS}, got {init!r}")
+        layout = _layout(groups)
+        self.layout = layout
+        self.n_signals = layout.n_series
         self.knots = knots
-        self.basis = HouseholderBasis(n_signals, dtype=dtype)
-        self.phi = SkipMLP(n_signals - 1, hidden, init, dtype) if n_signals > 1 else None
+        self.hidden = hidden
+        sizes = layout.sizes.tolist()
+        n_groups, n_out = len(sizes), max(sizes) - 1
+        self.n_outputs = n_out
+        if seeds is None:
+            seeds = torch.randint(2**31 - 1, (n_groups,)).tolist()
+        if len(seeds) != n_groups:
+            raise ValueError(f"{len(seeds)} seeds for {n_groups} groups")
+        w1 = torch.zeros(n_groups, 1, hidden, dtype=dtype)
+        w2 = torch.zeros(n_groups, hidden, hidden, dtype=dtype)
+        w3 = torch.zeros(n_groups, 2 * hidden + 1, max(n_out, 0), dtype=dtype)
+        for g, (size, seed) in enumerate(zip(sizes, seeds, strict=True)):
+            generator = torch.Generator().manual_seed(int(seed))
+            if init != "zeros":
+                w1[g] = _xavier((1, hidden), 1, hidden, generator)
+                w2[g] = _xavier((hidden, hidden), hidden, hidden, generator)
+            if init == "xavier" and size > 1:
+                w3[g, :, : size - 1] = _xavier((2 * hidden + 1, size - 1), 2 * hidden + 1,
+                                               size - 1, generator)  # fmt: skip
+        self.w1 = nn.Parameter(w1)
+        self.b1 = nn.Parameter(torch.zeros(n_groups, 1, hidden, dtype=dtype))
+        self.w2 = nn.Parameter(w2)
+        self.b2 = nn.Parameter(torch.zeros(n_groups, 1, hidden, dtype=dtype))
+        self.w3 = nn.Parameter(w3)
+        self.b3 = nn.Parameter(torch.zeros(n_groups, 1, max(n_out, 0), dtype=dtype))
+        columns = torch.arange(max(n_out, 0))
+        self.register_buffer(
+            "mask", (columns < (layout.sizes - 1).unsqueeze(-1)).to(dtype).unsqueeze(1)
+        )
+        # each group's Householder vector u_g in R^{N_g}, zero-padded to the largest group
+        entries = torch.arange(max(sizes))
+        size = layout.sizes.to(dtype).unsqueeze(-1)
+        u = torch.where(entries < layout.sizes.unsqueeze(-1), -1.0 / torch.sqrt(size), 0.0)
+        u[:, 0] += 1.0
+        norm_sq = (u * u).sum(-1)
+        self.register_buffer("u", u.to(dtype))
+        self.register_buffer(
+            "scale",
+            torch.where(norm_sq > 0, 2.0 / norm_sq.clamp_min(1e-300), 0.0).view(-1, 1, 1),
+        )
+        self.register_buffer("_rows", layout.codes * max(sizes) + layout.positions)
+        self._stencil: tuple | None = None
+
+    def parameter_groups(self) -> list[torch.Tensor]:
+        groups = torch.arange(self.layout.n_groups, device=self.w1.device)
+        return [groups for _ in self.parameters()]
+
+    def network(self, times: torch.Tensor) -> torch.Tensor:
+        """``phi_theta`` of every group at ``times`` (K,): shape (n_groups, K, N_max - 1)."""
+        x = times.view(1, -1, 1).expand(self.w1.shape[0], -1, 1)
+        h1 = torch.relu(torch.baddbmm(self.b1, x, self.w1))
+        h2 = torch.relu(torch.baddbmm(self.b2, h1, self.w2))
+        features = torch.cat([h2, h1, x], dim=-1)
+        return torch.baddbmm(self.b3, features, self.w3) * self.mask
 
     def offsets(self, zhat: torch.Tensor) -> torch.Tensor:
-        """``sum_k phi_theta(zhat)_k e_{k+1}``, shape (Z, N)."""
-        if self.phi is None:
-            raise RuntimeError("one signal has no warp offsets")
-        if self.knots is None or self.knots >= zhat.shape[0]:
-            return self.basis.combine(self.phi(zhat))
-        grid = unit_time(self.knots, dtype=zhat.dtype, device=zhat.device)
-        return resample_linear(self.basis.combine(self.phi(grid)), zhat)
+        """``sum_k phi_theta(zhat)_k e_{k+1}`` of every series, shape (N, Z)."""
+        if self.n_outputs < 1:
+            raise RuntimeError("groups of one signal have no warp offsets")
+        times = zhat
+        resample = self.knots is not None and self.knots < zhat.shape[0]
+        if resample:
+            assert self.knots is not None
+            times = unit_time(self.knots, dtype=zhat.dtype, device=zhat.device)
+        padded = torch.nn.functional.pad(self.network(times), (1, 0))  # (G, K, N_max)
+        dot = padded @ self.u.unsqueeze(-1)  # (G, K, 1)
+        combined = padded - self.scale * dot * self.u.unsqueeze(1)
+        per_series = combined.transpose(1, 2).reshape(-1, times.shape[0])[self._rows]
+        if not resample:
+            return per_series
+        left, weight = self._knot_stencil(zhat)
+        return torch.lerp(per_series[:, left], per_series[:, left + 1], weight)
+
+    def _knot_stencil(self, zhat: torch.Tensor):
+        key = (zhat.shape[0], zhat.device)
+        if self._stencil is None or self._stencil[0] != key:
+            assert self.knots is not None
+            self._stencil = (key, *_linear_stencil(self.knots, zhat))
+        return self._stencil[1], self._stencil[2]
 
     def forward(self, zhat: torch.Tensor) -> torch.Tensor:
         """Raw warps, shape (N, Z)."""
         identity = zhat.expand(self.n_signals, -1)
-        if self.phi is None:
+        if self.n_outputs < 1:
             return identity
-        return identity + (zhat * (1.0 - zhat)).unsqueeze(0) * self.offsets(zhat).T
+        return identity + (zhat * (1.0 - zhat)) * self.offsets(zhat)
 
     @staticmethod
     def finalise(raw: torch.Tensor) -> torch.Tensor:
@@ -212,21 +302,49 @@ class NeuralWarps(nn.Module):
 
 
 class SineWarps(nn.Module):
-    """TTW warps from ``n_components`` discrete-sine-transform coefficients per signal."""
+    """TTW warps from ``n_components`` discrete-sine-transform coefficients per signal.
 
-    def __init__(self, n_signals: int, n_components: int = 8, dtype=torch.float64):
+    Parameters
+    ----------
+    groups : int, sequence of int or GroupLayout
+        Number of series (one group), the size of every group, or the layout.
+    n_components : int, default=8
+    """
+
+    def __init__(
+        self,
+        groups: int | Sequence[int] | GroupLayout,
+        n_components: int = 8,
+        dtype=torch.float64,
+    ):
         super().__init__()
         if n_components < 1:
             raise ValueError(f"n_components must be >= 1, got {n_components}")
-        self.coefficients = nn.Parameter(torch.zeros(n_signals, n_components, dtype=dtype))
+        self.layout = _layout(groups)
+        self.coefficients = nn.Parameter(
+            torch.zeros(self.layout.n_series, n_components, dtype=dtype)
+        )
+        self._basis: tuple | None = None
+
+    def parameter_groups(self) -> list[torch.Tensor]:
+        return [self.layout.codes.to(self.coefficients.device)]
+
+    def _sines(self, zhat: torch.Tensor) -> torch.Tensor:
+        key = (zhat.shape[0], zhat.device)
+        if self._basis is None or self._basis[0] != key:
+            k = torch.arange(1, self.coefficients.shape[1] + 1, dtype=zhat.dtype,
+                             device=zhat.device)  # fmt: skip
+            basis = torch.sin(math.pi * k.unsqueeze(-1) * zhat)  # (K, Z)
+            # sin(pi k) is ~1e-16 in floating point: make the end points exact
+            basis = basis * ((zhat > 0) & (zhat < 1)).to(basis.dtype)
+            self._basis = (key, basis)
+        return self._basis[1]
 
     def forward(self, zhat: torch.Tensor) -> torch.Tensor:
-        k = torch.arange(1, self.coefficients.shape[1] + 1, dtype=zhat.dtype, device=zhat.device)
-        basis = torch.sin(math.pi * k.unsqueeze(-1) * zhat)  # (K, Z)
-        # sin(pi k) is ~1e-16 in floating point: make the end points exact
-        basis = basis * ((zhat > 0) & (zhat < 1)).to(basis.dtype)
-        centred = self.coefficients - self.coefficients.mean(0, keepdim=True)
-        return zhat + centred @ basis
+        layout = self.layout.to(zhat.device)
+        share = 1.0 / layout.sizes.to(zhat.dtype).unsqueeze(-1)
+        centred = self.coefficients - layout.expand(layout.sum(self.coefficients) * share)
+        return zhat + centred @ self._sines(zhat)
 
     @staticmethod
     def finalise(raw: torch.Tensor) -> torch.Tensor:

@@ -1,13 +1,10 @@
-"""Class-mean estimators: one Riemannian time-warping mean per class."""
+"""Class-mean estimators: one Riemannian time-warping mean per class (or several)."""
 
 from __future__ import annotations
 
-import sys
-import time
 from typing import Any
 
 import numpy as np
-from joblib import Parallel, delayed
 from sklearn.base import BaseEstimator, TransformerMixin
 from sklearn.utils import check_random_state, column_or_1d
 from sklearn.utils.multiclass import check_classification_targets
@@ -15,24 +12,24 @@ from sklearn.utils.validation import check_is_fitted
 
 from .._numba import check_n_jobs
 from .._random import check_random_state_value
-from ..align import METHODS, Alignment, align, classification_output_length
 from ..align._config import check_preset
-from ..baselines import MultipleAlignment, dba_average
 from ..dtw import check_window, dtw_pairwise_distance
 from ..manifolds import Manifold
-from ..utils import SeriesCollection, check_series_collection
-
-#: Averaging methods of the estimators: the engine's and DTW barycenter averaging.
-ESTIMATOR_METHODS = (*METHODS, "dba")
+from ..utils import check_series_collection
+from ._core import ESTIMATOR_METHODS, centre_settings, engine_keywords, fit_centres, kmeans
 
 
 class RTWAverager(TransformerMixin, BaseEstimator):
-    """Learn one Riemannian Time Warping mean per class; transform to DTW distances.
+    """Learn one Riemannian Time Warping mean per class (or several); transform to DTW
+    distances.
 
-    ``fit`` averages the series of each class separately -- with :func:`sk_rtw.align`
-    (RTW, TTW, NTW) or with manifold DTW barycenter averaging (``method="dba"``) -- and
-    keeps the class means; ``transform`` returns the manifold-DTW distance of each series
-    to each mean (like ``KMeans.transform``).
+    ``fit`` averages the series of each class -- with the alignment engine of
+    :func:`sk_rtw.align` (RTW, TTW, NTW; every class in one batched optimisation) or with
+    manifold DTW barycenter averaging (``method="dba"``) -- and keeps the class means;
+    ``transform`` returns the manifold-DTW distance of each series to each mean (like
+    ``KMeans.transform``). With ``n_centroids=k`` every class is clustered into ``k``
+    centroids by k-means with the same averaging, and ``transform`` returns the distance
+    to every centroid: features for a downstream classifier.
 
     Parameters
     ----------
@@ -53,7 +50,7 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         ``N_max T_max`` with ``N_max`` the largest class. Not used by DBA, whose means keep
         the length of their start (the class medoid).
     n_epochs : int, default=256
-        Adam epochs per class.
+        Most Adam epochs per class.
     learning_rate : float, default=0.01
     sinc_window, loss_window, loss_step, penalty : optional
         Engine settings; None takes the method's default (see :func:`sk_rtw.align`).
@@ -61,20 +58,31 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         Starting warps (``"auto"``: the preset's; RTW starts from DTW paths by default).
     n_components : int, default=8
         Sine terms of the TTW warps (TTW only).
-    hidden_size : int, default=512
-        Hidden width of the RTW/NTW warp network.
+    hidden_size : int or "auto", default="auto"
+        Hidden width of the RTW/NTW warp network (``"auto"``: the preset's, 64; the paper's
+        512 with ``preset="paper"``).
     warp_knots : int, None or "auto", default="auto"
         Times at which the warp network is evaluated (linear in between); None: at every
         output time (the paper); ``"auto"``: the preset's (64, or None for the paper).
     tangent_refinements : int or "auto", default="auto"
         Gauss–Newton refinements of the interpolation tangent point (``"auto"``: the
         preset's, 0 or 2 for the paper).
-    mean_iterations : int, default=5
-        Gauss–Newton iterations of the mean per epoch.
+    mean_iterations : int or "auto", default="auto"
+        Gauss–Newton iterations of the mean per epoch (``"auto"``: the preset's).
+    n_iter_no_change : int, None or "auto", default="auto"
+        Stop a class's training after this many epochs without a relative improvement of
+        ``tol`` (None: all ``n_epochs``; ``"auto"``: the preset's).
+    tol : float, optional
+        Relative improvement that counts for ``n_iter_no_change`` (default 1e-4).
+    n_centroids : int, default=1
+        Centroids per class. Above 1, each class is clustered by k-means (the estimator's
+        averaging method, k-means++ seeding, at most 10 rounds; at most one centroid per
+        series), and ``means_`` holds every centroid.
     dtw_window : float in [0, 1], optional
         Sakoe–Chiba band of the DTW used by ``transform`` (and by DBA).
     n_jobs : int, optional
-        Classes fitted in parallel (joblib) and threads of the DTW computations.
+        Threads of the fit (scikit-learn's convention, None: 1) and of the DTW
+        computations; DBA fits classes in parallel with joblib.
     random_state : int, RandomState or None
         Seeds the warp initialisation of every class.
     device : str, default="cpu"
@@ -86,15 +94,16 @@ class RTWAverager(TransformerMixin, BaseEstimator):
     ----------
     classes_ : ndarray of shape (n_classes,)
         Class labels (``[0]`` when fitted without ``y``).
-    means_ : ndarray of shape (n_classes, Z, *point_shape) or list of ndarray
-        One mean per class, on the manifold; a list when the means differ in length
-        (DBA on series of unequal lengths).
+    means_ : ndarray of shape (n_means, Z, *point_shape) or list of ndarray
+        Every centroid, on the manifold (one per class unless ``n_centroids > 1``); a list
+        when they differ in length (DBA on series of unequal lengths).
+    centroid_classes_ : ndarray of shape (n_means,)
+        Class index (into ``classes_``) of every entry of ``means_``.
     alignments_ : list of Alignment or MultipleAlignment
-        Per class: aligned series, warps and, for the engine's methods, loss history and
-        configuration.
-    centroid_classes_ : ndarray of shape (n_classes,)
-        Class index of every entry of ``means_`` (``arange(n_classes)``; the classifier's
-        ``n_centroids`` makes it longer).
+        Per entry of ``means_``: aligned series, warps and, for the engine's methods, loss
+        history and configuration.
+    assignments_ : ndarray of shape (n_series,)
+        Entry of ``means_`` that every training series was averaged into.
     method_ : str
         The averaging method used.
     manifold_ : Manifold
@@ -132,10 +141,14 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         penalty: float | None = None,
         warp_start: str = "auto",
         n_components: int = 8,
-        hidden_size: int = 512,
+        hidden_size: int | str = "auto",
         warp_knots: int | str | None = "auto",
         tangent_refinements: int | str = "auto",
-        mean_iterations: int = 5,
+        mean_iterations: int | str = "auto",
+        mean_weights: str = "auto",
+        n_iter_no_change: int | str | None = "auto",
+        tol: float | None = None,
+        n_centroids: int = 1,
         dtw_window: float | None = None,
         n_jobs: int | None = None,
         random_state: Any = None,
@@ -158,6 +171,10 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         self.warp_knots = warp_knots
         self.tangent_refinements = tangent_refinements
         self.mean_iterations = mean_iterations
+        self.mean_weights = mean_weights
+        self.n_iter_no_change = n_iter_no_change
+        self.tol = tol
+        self.n_centroids = n_centroids
         self.dtw_window = dtw_window
         self.n_jobs = n_jobs
         self.random_state = random_state
@@ -190,9 +207,16 @@ class RTWAverager(TransformerMixin, BaseEstimator):
             )
         return method.lower()
 
-    def _fit_means(self, X, y, require_two_classes, n_centroids: int = 1):
+    def _check_n_centroids(self) -> int:
+        k = self.n_centroids
+        if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
+            raise ValueError(f"n_centroids must be an integer >= 1, got {k!r}")
+        return int(k)
+
+    def _fit_means(self, X, y, require_two_classes):
         """Validate, then fit ``n_centroids`` means per class (k-means above 1)."""
         method = self._resolve_method()
+        n_centroids = self._check_n_centroids()
         check_preset(self.preset)
         check_random_state_value(self.random_state)
         check_n_jobs(self.n_jobs)
@@ -209,130 +233,45 @@ class RTWAverager(TransformerMixin, BaseEstimator):
                 f"class ({classes.tolist()})"
             )
         sizes = np.bincount(codes)
-        output_length = self.output_length
-        if output_length is None:
-            output_length = classification_output_length(
-                int(sizes.max()), collection.max_length, self.preset or "default"
-            )
+        settings = centre_settings(
+            method,
+            engine=engine_keywords(self.get_params(), output_length=self.output_length),
+            dtw_window=self.dtw_window, n_jobs=self.n_jobs, verbose=self.verbose,
+            owner=type(self).__name__,
+        )  # fmt: skip
         seeds = check_random_state(self.random_state).randint(2**31 - 1, size=len(classes))
-        members = [np.flatnonzero(codes == k) for k in range(len(classes))]
-        fit_one = self._fit_class if n_centroids == 1 else self._cluster_class
-        jobs = (
-            delayed(fit_one)(
-                collection.subset(idx), method, output_length, int(seed), label, n_centroids
-            )
-            for idx, seed, label in zip(members, seeds, classes, strict=True)
-        )
-        if self.n_jobs in (None, 1) or len(classes) == 1:
-            fitted = [fn(*args, **kwargs) for fn, args, kwargs in jobs]
+        if n_centroids == 1:
+            fits = fit_centres(collection, codes, [int(s) for s in seeds], settings,
+                              list(classes), kind="class")  # fmt: skip
+            centroid_classes = np.arange(len(classes))
+            assignments = codes
         else:
-            fitted = Parallel(n_jobs=self.n_jobs)(jobs)
+            rngs = [np.random.RandomState(int(s)) for s in seeds]
+            clusterings = kmeans(collection, codes, [min(n_centroids, int(n)) for n in sizes],
+                                 settings, rngs)  # fmt: skip
+            fits = [fit for clustering in clusterings for fit in clustering.fits]
+            counts = [len(clustering.fits) for clustering in clusterings]
+            centroid_classes = np.repeat(np.arange(len(classes)), counts)
+            offsets = np.concatenate([[0], np.cumsum(counts)[:-1]])
+            assignments = np.empty(collection.n_series, dtype=np.int64)
+            for c, clustering in enumerate(clusterings):
+                assignments[codes == c] = offsets[c] + clustering.labels
         self.classes_ = classes
         self.method_ = method
         self.manifold_ = collection.manifold
-        if n_centroids == 1:
-            self.alignments_ = fitted
-            per_class = [[a.mean] for a in fitted]
-        else:
-            self.clusterings_ = fitted
-            per_class = [list(kmeans.cluster_centers_) for kmeans in fitted]
-        means = [m for class_means in per_class for m in class_means]
-        self.centroid_classes_ = np.repeat(
-            np.arange(len(classes)), [len(class_means) for class_means in per_class]
-        )
+        self.alignments_ = fits
+        self.centroid_classes_ = centroid_classes
+        self.assignments_ = assignments
+        means = [fit.mean for fit in fits]
         same_length = len({len(m) for m in means}) == 1
         self.means_ = np.stack(means) if same_length else means
         if collection.equal_length and collection.manifold.point_shape == (1,):
             self.n_features_in_ = collection.max_length
         return self
 
-    def _engine_options(self) -> dict[str, Any]:
-        options: dict[str, Any] = {
-            "n_components": self.n_components,
-            "hidden_size": self.hidden_size,
-            "mean_iterations": self.mean_iterations,
-        }
-        if not (isinstance(self.warp_knots, str) and self.warp_knots == "auto"):
-            options["warp_knots"] = self.warp_knots
-        if not (isinstance(self.tangent_refinements, str) and self.tangent_refinements == "auto"):
-            options["tangent_refinements"] = self.tangent_refinements
-        return options
-
-    def _cluster_class(
-        self, collection: SeriesCollection, method: str, output_length: int, seed: int, label,
-        n_centroids: int,
-    ):  # fmt: skip
-        """k-means within one class, centres by this estimator's averaging settings."""
-        from ._kmeans import RTWKMeans
-
-        shared = ("manifold", "method", "output_length", "n_epochs", "preset", "dtw_window",
-                  "n_jobs", "random_state", "device", "verbose")  # fmt: skip
-        averager_params = {
-            name: getattr(self, name)
-            for name in RTWAverager._get_param_names()
-            if name not in shared
-        }
-        return RTWKMeans(
-            n_clusters=min(n_centroids, collection.n_series),
-            method=method,
-            manifold=collection.manifold,
-            output_length=output_length,
-            n_epochs=self.n_epochs,
-            preset=self.preset,
-            dtw_window=self.dtw_window,
-            n_jobs=self.n_jobs,
-            random_state=seed,
-            device=self.device,
-            verbose=self.verbose,
-            averager_params=averager_params,
-        ).fit(collection)
-
-    def _fit_class(
-        self,
-        collection: SeriesCollection,
-        method: str,
-        output_length: int,
-        seed: int,
-        label,
-        n_centroids: int = 1,
-    ):
-        start = time.perf_counter()
-        result: MultipleAlignment | Alignment
-        if method == "dba":
-            result = dba_average(collection, window=self.dtw_window)
-            detail = f"cost {result.cost:.4g}"
-        else:
-            result = align(
-                collection,
-                method=method,
-                preset=self.preset,
-                output_length=output_length,
-                n_epochs=self.n_epochs,
-                learning_rate=self.learning_rate,
-                sinc_window=self.sinc_window,
-                loss_window=self.loss_window,
-                loss_step=self.loss_step,
-                penalty=self.penalty,
-                warp_start=self.warp_start,
-                random_state=seed,
-                device=self.device,
-                verbose=self.verbose >= 2,
-                **self._engine_options(),
-            )
-            detail = f"best epoch {result.best_epoch + 1}"
-        if self.verbose:
-            name = label.item() if isinstance(label, np.generic) else label
-            print(
-                f"[{type(self).__name__}] class {name!r}: {collection.n_series} series, "
-                f"{method}, {time.perf_counter() - start:.1f} s, {detail}",
-                file=sys.stderr,
-                flush=True,
-            )
-        return result
-
     # ------------------------------------------------------------ transform
     def transform(self, X: Any) -> np.ndarray:
-        """Manifold-DTW distance of every series to every class mean.
+        """Manifold-DTW distance of every series to every mean (every centroid).
 
         Parameters
         ----------
@@ -341,7 +280,10 @@ class RTWAverager(TransformerMixin, BaseEstimator):
 
         Returns
         -------
-        distances : ndarray of shape (n_series, n_classes)
+        distances : ndarray of shape (n_series, n_means)
+            One column per entry of ``means_`` (``n_classes`` columns, or
+            ``n_centroids x n_classes`` with ``n_centroids > 1``; ``centroid_classes_``
+            gives the class of each column).
         """
         check_is_fitted(self, "means_")
         collection = check_series_collection(X, self.manifold_, min_length=1)

@@ -58,37 +58,38 @@ class RTWNearestCentroid(ClassifierMixin, RTWAverager):
 
     Parameters
     ----------
-    manifold, output_length, n_epochs, learning_rate, sinc_window, loss_window, \
-loss_step, penalty, n_components, hidden_size, warp_knots, tangent_refinements, \
-mean_iterations, dtw_window, n_jobs, random_state, device, verbose
+    manifold, method, preset, output_length, n_epochs, learning_rate, sinc_window, \
+loss_window, loss_step, penalty, warp_start, n_components, hidden_size, warp_knots, \
+tangent_refinements, mean_iterations, n_iter_no_change, tol, dtw_window, n_jobs, \
+random_state, device, verbose
         As in :class:`RTWAverager`.
+    n_centroids : int, default=1
+        Centroids per class, as in :class:`RTWAverager` (k-means within each class); a
+        series gets the class of its nearest centroid (Petitjean et al., ICDM 2014: a few
+        DBA centroids per class approach 1-NN DTW at a fraction of its cost).
     temperature : float or "auto", default="auto"
         Scale of the distances in :meth:`predict_proba`,
         ``softmax(-d(x, mean_k) / temperature)``. ``"auto"`` fits it in ``fit`` by
         minimising the log-loss of the training series (one DTW per training series and
         class): raw DTW distances are in the data's units, so a fixed scale either
         saturates to 0/1 rows or flattens to uniform ones. Predictions do not depend on it.
-    n_centroids : int, default=1
-        Centroids per class. Above 1, each class is clustered by :class:`RTWKMeans` (same
-        averaging method, ``n_init=1``, ``max_iter=10``; at most one centroid per series)
-        and a series gets the class of its nearest centroid (Petitjean et al., ICDM 2014:
-        a few DBA centroids per class approach 1-NN DTW at a fraction of its cost).
 
     Attributes
     ----------
     classes_ : ndarray of shape (n_classes,)
-    means_ : ndarray of shape (n_classes, Z, *point_shape)
-    alignments_ : list of Alignment
+    means_ : ndarray of shape (n_means, Z, *point_shape)
+        Every centroid (one per class unless ``n_centroids > 1``).
+    centroid_classes_ : ndarray of shape (n_means,)
+        Class index of every entry of ``means_``; :meth:`transform` returns, per class,
+        the distance to its nearest centroid (``RTWAverager.transform`` gives every
+        centroid's).
+    alignments_ : list of Alignment or MultipleAlignment
+        One per entry of ``means_``.
+    assignments_ : ndarray of shape (n_series,)
+        Entry of ``means_`` each training series was averaged into.
     manifold_ : Manifold
     temperature_ : float
         The temperature used by :meth:`predict_proba`.
-    centroid_classes_ : ndarray of shape (n_means,)
-        Class index of every entry of ``means_`` (``means_`` holds all centroids when
-        ``n_centroids > 1``; ``transform`` returns the distance to the nearest centroid of
-        each class).
-    clusterings_ : list of RTWKMeans
-        With ``n_centroids > 1``, the k-means fit of every class (``alignments_`` is then
-        not set).
 
     Examples
     --------
@@ -116,23 +117,25 @@ mean_iterations, dtw_window, n_jobs, random_state, device, verbose
         penalty: float | None = None,
         warp_start: str = "auto",
         n_components: int = 8,
-        hidden_size: int = 512,
+        hidden_size: int | str = "auto",
         warp_knots: int | str | None = "auto",
         tangent_refinements: int | str = "auto",
-        mean_iterations: int = 5,
+        mean_iterations: int | str = "auto",
+        mean_weights: str = "auto",
+        n_iter_no_change: int | str | None = "auto",
+        tol: float | None = None,
+        n_centroids: int = 1,
         dtw_window: float | None = None,
         n_jobs: int | None = None,
         random_state: Any = None,
         device: str = "cpu",
         verbose: int = 0,
         temperature: float | str = "auto",
-        n_centroids: int = 1,
     ):
         averager = inspect.signature(RTWAverager.__init__).parameters
         values = locals()
         super().__init__(**{name: values[name] for name in averager if name != "self"})
         self.temperature = temperature
-        self.n_centroids = n_centroids
 
     def _check_temperature(self) -> None:
         if not (isinstance(self.temperature, str) and self.temperature == "auto"):
@@ -157,10 +160,7 @@ mean_iterations, dtw_window, n_jobs, random_state, device, verbose
                 f"{type(self).__name__} requires y to be passed, but the target y is None"
             )
         self._check_temperature()
-        k = self.n_centroids
-        if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
-            raise ValueError(f"n_centroids must be an integer >= 1, got {k!r}")
-        self._fit_means(X, y, require_two_classes=True, n_centroids=int(k))
+        self._fit_means(X, y, require_two_classes=True)
         if self.temperature == "auto":
             distances = self.transform(X)
             _, codes = _encode(_check_labels(y, len(distances), True))
@@ -186,8 +186,7 @@ mean_iterations, dtw_window, n_jobs, random_state, device, verbose
         if len(owners) == len(self.classes_):
             return distances
         out = np.full((len(distances), len(self.classes_)), np.inf)
-        for c in range(len(self.classes_)):
-            out[:, c] = distances[:, owners == c].min(1)
+        np.minimum.at(out.T, owners, distances.T)
         return out
 
     def predict(self, X: Any) -> np.ndarray:

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import sys
-import time
 from typing import Any
 
 import numpy as np
@@ -13,11 +11,25 @@ from sklearn.utils.validation import check_is_fitted
 
 from .._numba import check_n_jobs
 from .._random import check_random_state_value
-from ..align._config import check_int, check_positive
-from ..dtw import check_window, dtw_pairwise_distance
+from ..align._config import check_int, check_positive, check_preset
+from ..dtw import check_window
 from ..manifolds import Manifold
-from ..utils import SeriesCollection, check_series_collection
-from ._averager import ESTIMATOR_METHODS, RTWAverager
+from ..utils import check_series_collection
+from ._core import (
+    ENGINE_ARGUMENTS,
+    ENGINE_OPTIONS,
+    ESTIMATOR_METHODS,
+    centre_settings,
+    dtw_to_centres,
+    engine_keywords,
+    kmeans,
+)
+
+#: Engine settings of the centre fits that ``averager_params`` may set.
+AVERAGER_PARAMS = tuple(
+    name for name in (*ENGINE_ARGUMENTS, *ENGINE_OPTIONS)
+    if name not in ("preset", "n_epochs", "device")
+)  # fmt: skip
 
 
 class RTWKMeans(ClusterMixin, TransformerMixin, BaseEstimator):
@@ -166,101 +178,46 @@ class RTWKMeans(ClusterMixin, TransformerMixin, BaseEstimator):
                 f"n_clusters={self.n_clusters} needs at least as many series; got "
                 f"{collection.n_series}"
             )
+        self._settings = self._centre_settings(collection)
         rng = check_random_state(self.random_state)
+        problem = np.zeros(collection.n_series, dtype=np.int64)
         best = None
         for run in range(self.n_init):
-            outcome = self._lloyd(collection, rng, run)
-            if best is None or outcome[2] < best[2]:
+            (outcome,) = kmeans(
+                collection, problem, [self.n_clusters], self._settings, [rng],
+                max_iter=self.max_iter, tol=self.tol,
+                init_label=f"init {run + 1}/{self.n_init} ",
+            )  # fmt: skip
+            if best is None or outcome.inertia < best.inertia:
                 best = outcome
         assert best is not None
-        centres, labels, inertia, n_iter = best
         self.manifold_ = collection.manifold
-        same_length = len({len(c) for c in centres}) == 1
-        self.cluster_centers_ = np.stack(centres) if same_length else centres
-        self.labels_ = labels
-        self.inertia_ = float(inertia)
-        self.n_iter_ = n_iter
+        same_length = len({len(c) for c in best.centres}) == 1
+        self.cluster_centers_ = np.stack(best.centres) if same_length else best.centres
+        self.labels_ = best.labels
+        self.inertia_ = float(best.inertia)
+        self.n_iter_ = best.n_iter
         if collection.equal_length and collection.manifold.point_shape == (1,):
             self.n_features_in_ = collection.max_length
         return self
 
-    def _distances(self, collection: SeriesCollection, centres) -> np.ndarray:
-        means = check_series_collection(list(centres), collection.manifold, name="centres")
-        squared = dtw_pairwise_distance(
-            collection, means, window=self.dtw_window, squared=True, n_jobs=self.n_jobs
-        )
-        return np.sqrt(squared)
-
-    def _seed(self, collection: SeriesCollection, rng) -> list[np.ndarray]:
-        """k-means++ with DTW: each new centre drawn with probability ~ squared distance."""
-        n = collection.n_series
-        chosen = [int(rng.randint(n))]
-        nearest = self._distances(collection, [collection.series(chosen[0])])[:, 0]
-        for _ in range(1, self.n_clusters):
-            weights = nearest**2
-            total = weights.sum()
-            if total > 0 and np.isfinite(total):
-                pick = int(rng.choice(n, p=weights / total))
-            else:  # every series sits on a chosen one: take any other
-                pick = int(rng.choice(np.setdiff1d(np.arange(n), chosen)))
-            chosen.append(pick)
-            new = self._distances(collection, [collection.series(pick)])[:, 0]
-            nearest = np.minimum(nearest, new)
-        return [collection.series(i) for i in chosen]
-
-    def _average(self, collection: SeriesCollection, labels: np.ndarray, seed: int):
-        averager = RTWAverager(
-            **(self.averager_params or {}),
-            manifold=collection.manifold,
-            method=self.method.lower(),
-            preset=self.preset,
-            output_length=self.output_length,
-            n_epochs=self.n_epochs,
-            dtw_window=self.dtw_window,
-            n_jobs=self.n_jobs,
-            random_state=seed,
-            device=self.device,
-            verbose=max(0, self.verbose - 1),
-        ).fit(collection, labels)
-        return list(averager.means_)
-
-    def _lloyd(self, collection: SeriesCollection, rng, run: int):
-        centres = self._seed(collection, rng)
-        distances = self._distances(collection, centres)
-        labels = distances.argmin(1)
-        inertia = _inertia(distances, labels)
-        best = None
-        n_iter = 0
-        for n_iter in range(1, self.max_iter + 1):
-            start = time.perf_counter()
-            labels, reseeded = _fill_empty(labels, distances, self.n_clusters)
-            fitted = self._average(collection, labels, int(rng.randint(2**31 - 1)))
-            centres = list(fitted)
-            distances = self._distances(collection, centres)
-            new_labels = distances.argmin(1)
-            new_inertia = _inertia(distances, new_labels)
-            changed = int((new_labels != labels).sum())
-            if self.verbose:
-                print(
-                    f"[RTWKMeans] init {run + 1}/{self.n_init} iteration {n_iter}: inertia "
-                    f"{new_inertia:.6g}, {changed} series changed cluster"
-                    + (f", {reseeded} empty cluster(s) re-seeded" if reseeded else "")
-                    + f", {time.perf_counter() - start:.1f} s",
-                    file=sys.stderr,
-                    flush=True,
-                )
-            improved = inertia - new_inertia
-            labels, inertia = new_labels, new_inertia
-            if np.all(np.bincount(labels, minlength=self.n_clusters) > 0) and (
-                best is None or inertia < best[2]
-            ):
-                best = (centres, labels, inertia, n_iter)
-            if changed == 0 or (reseeded == 0 and improved <= self.tol * abs(inertia)):
-                break
-        if best is None:  # every iterate left a cluster empty: keep the last, filled
-            labels, _ = _fill_empty(labels, distances, self.n_clusters)
-            best = (centres, labels, _inertia(distances, labels), n_iter)
-        return best[0], best[1], best[2], n_iter  # the best iterate, the rounds run
+    def _centre_settings(self, collection):
+        method = self.method.lower()
+        params = dict(self.averager_params or {})
+        unknown = sorted(set(params) - set(AVERAGER_PARAMS))
+        if unknown:
+            raise TypeError(
+                f"averager_params has unknown engine setting(s) {unknown}; known: "
+                f"{list(AVERAGER_PARAMS)}"
+            )
+        check_preset(self.preset)
+        params.update(preset=self.preset, n_epochs=self.n_epochs, device=self.device)
+        return centre_settings(
+            method,
+            engine=engine_keywords(params, output_length=self.output_length),
+            dtw_window=self.dtw_window, n_jobs=self.n_jobs, verbose=self.verbose,
+            owner="RTWKMeans",
+        )  # fmt: skip
 
     # ------------------------------------------------------------ inference
     def transform(self, X: Any) -> np.ndarray:
@@ -277,7 +234,7 @@ class RTWKMeans(ClusterMixin, TransformerMixin, BaseEstimator):
         """
         check_is_fitted(self, "cluster_centers_")
         collection = check_series_collection(X, self.manifold_, min_length=1)
-        return self._distances(collection, self.cluster_centers_)
+        return dtw_to_centres(collection, list(self.cluster_centers_), self._settings)
 
     def predict(self, X: Any) -> np.ndarray:
         """Index of the nearest centre.
@@ -312,25 +269,3 @@ class RTWKMeans(ClusterMixin, TransformerMixin, BaseEstimator):
         tags.input_tags.allow_nan = False
         tags.non_deterministic = False
         return tags
-
-
-def _inertia(distances: np.ndarray, labels: np.ndarray) -> float:
-    return float((distances[np.arange(len(labels)), labels] ** 2).sum())
-
-
-def _fill_empty(
-    labels: np.ndarray, distances: np.ndarray, n_clusters: int
-) -> tuple[np.ndarray, int]:
-    """Give every empty cluster the series farthest from its own centre (scikit-learn's
-    rule), never emptying another cluster; returns the labels and how many were filled."""
-    labels = labels.copy()
-    filled = 0
-    for k in range(n_clusters):
-        if np.any(labels == k):
-            continue
-        own = distances[np.arange(len(labels)), labels].copy()
-        sizes = np.bincount(labels, minlength=n_clusters)
-        own[sizes[labels] < 2] = -np.inf  # a series alone in its cluster stays there
-        labels[int(np.argmax(own))] = k
-        filled += 1
-    return labels, filled
