@@ -302,8 +302,9 @@ def align_at_scale(scale):
     data = make_warped_signals("euclidean", 4, 40, 1).signals
     factor = Euclidean(1).extreme_scale(scale * data)
     assert factor is not None
-    result = align(scale * data, n_epochs=30, random_state=0)
-    reference = align(scale * data / factor, n_epochs=30, random_state=0)  # the same frame
+    options = {"n_epochs": 30, "n_iter_no_change": None, "random_state": 0}
+    result = align(scale * data, **options)
+    reference = align(scale * data / factor, **options)  # the same frame
     np.testing.assert_allclose(result.warps, reference.warps, atol=1e-12)
     np.testing.assert_allclose(result.mean, reference.mean * factor, rtol=1e-9)
     assert result.best_epoch > 0  # the warps were trained, not left at their start

@@ -79,8 +79,8 @@ PRESET_DEFAULTS: dict[str, dict[str, Any]] = {
         "hidden_size": 64,
         "mean_iterations": 2,
         "mean_start": "previous",
-        "n_iter_no_change": 20,
-        "tol": 1e-4,
+        "n_iter_no_change": 10,
+        "tol": 1e-3,
     },
     "paper": {
         "warp_knots": None,
@@ -91,8 +91,7 @@ PRESET_DEFAULTS: dict[str, dict[str, Any]] = {
         "n_iter_no_change": None,
     },
 }
-PRESET_DEFAULTS["class-means"] = {**PRESET_DEFAULTS["alignment"], "n_iter_no_change": 10,
-                                  "tol": 1e-3}  # fmt: skip
+PRESET_DEFAULTS["class-means"] = dict(PRESET_DEFAULTS["alignment"])
 MEAN_STARTS = ("first", "previous")
 #: How the aligned series are weighted in the mean (see :mod:`sk_rtw.align._density`).
 MEAN_WEIGHTS = ("equal", "density")
