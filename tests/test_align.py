@@ -778,7 +778,9 @@ def test_density_mean_from_dtw_runs_is_dbas_update(rng):
         series.append(rng.standard_normal((sum(runs), 3)))
         paths.append(np.array([(m, j) for m, (a, r) in enumerate(zip(starts, runs, strict=True))
                                for j in range(a, a + r)]))  # fmt: skip
-    warps = np.stack([path_warp(p, n_mean, len(s), smoothing=0) for p, s in zip(paths, series)])
+    warps = np.stack(
+        [path_warp(p, n_mean, len(s), smoothing=0) for p, s in zip(paths, series, strict=True)]
+    )
     v, w, _ = _density(E, series, warps)
     mean = group_mean(E, v, GroupLayout.single(len(series)), w)[0].numpy()
     sums, counts = np.zeros((n_mean, 3)), np.zeros(n_mean)

@@ -31,7 +31,7 @@ def test_multiscale_path_matches_the_exact_path_on_smooth_series(manifold, rng):
         )
 
     x, y = curve(t), curve(t[:800] ** 1.3)
-    exact, exact_cost = path_indices(x, y, manifold, squared=True)
+    _, exact_cost = path_indices(x, y, manifold, squared=True)
     band, band_cost = multiscale_path(x, y, manifold, squared=True, exact_cells=1000)
     assert band[0].tolist() == [0, 0] and band[-1].tolist() == [len(x) - 1, len(y) - 1]
     assert np.all(np.diff(band, axis=0) >= 0) and np.all(np.diff(band, axis=0).sum(1) >= 1)
@@ -40,11 +40,11 @@ def test_multiscale_path_matches_the_exact_path_on_smooth_series(manifold, rng):
 
 def test_multiscale_path_is_close_on_rough_series(rng):
     x, y = rng.standard_normal((700, 1)).cumsum(0), rng.standard_normal((650, 1)).cumsum(0)
-    exact, exact_cost = path_indices(x, y, Euclidean(1))
-    band, band_cost = multiscale_path(x, y, Euclidean(1), exact_cells=1000)
+    _, exact_cost = path_indices(x, y, Euclidean(1))
+    _, band_cost = multiscale_path(x, y, Euclidean(1), exact_cells=1000)
     assert exact_cost <= band_cost <= 1.01 * exact_cost
     # small problems are solved exactly
-    small, small_cost = multiscale_path(x[:100], y[:90], Euclidean(1))
+    small, _ = multiscale_path(x[:100], y[:90], Euclidean(1))
     np.testing.assert_array_equal(small, path_indices(x[:100], y[:90], Euclidean(1))[0])
 
 
