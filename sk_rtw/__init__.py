@@ -3,7 +3,7 @@
 Align, average and classify time series whose samples live on Riemannian manifolds.
 """
 
-from . import baselines, datasets, metrics
+from . import baselines, datasets, metrics, statistics
 from .align import Alignment, align
 from .dtw import dtw_cost_matrix, dtw_distance, dtw_pairwise_distance, dtw_path
 from .estimators import (
@@ -25,12 +25,15 @@ from .manifolds import (
     available_manifolds,
     get_manifold,
 )
+from .statistics import AlignedStatistics, ConfidenceTube, aligned_statistics
 
 __version__ = "0.1.0.dev0"
 
 __all__ = [
     "SPD",
+    "AlignedStatistics",
     "Alignment",
+    "ConfidenceTube",
     "Euclidean",
     "Manifold",
     "NTWAverager",
@@ -45,6 +48,7 @@ __all__ = [
     "TTWNearestCentroid",
     "__version__",
     "align",
+    "aligned_statistics",
     "available_manifolds",
     "baselines",
     "datasets",
@@ -54,4 +58,5 @@ __all__ = [
     "dtw_path",
     "get_manifold",
     "metrics",
+    "statistics",
 ]

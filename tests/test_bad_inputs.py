@@ -401,3 +401,26 @@ CORRECT = [
 @pytest.mark.parametrize("check", [c[1] for c in CORRECT], ids=[c[0] for c in CORRECT])
 def test_valid_input_gives_the_right_answer(check):
     check()
+
+
+@pytest.mark.parametrize("manifold", [Euclidean(2), Sphere(2), SPD(2), Quaternion()], ids=repr)
+def test_a_mean_of_zero_samples_says_so(manifold):
+    import torch
+
+    for empty in (np.zeros((0, *manifold.point_shape)), torch.zeros((0, *manifold.point_shape))):
+        with pytest.raises(ValueError, match="mean of zero samples"):
+            manifold.mean(empty)
+
+
+def test_spd_beyond_float64_conditioning_is_rejected_with_its_eigenvalues():
+    """A rotated SPD matrix with eigenvalues 1e-150 and 1e150 cannot be held in float64
+    (its small eigenvalue is rounding noise): rejected, naming the range and the limit;
+    the same eigenvalues on the diagonal are a valid extreme input."""
+    theta = 0.3
+    rotation = np.array([[np.cos(theta), -np.sin(theta)], [np.sin(theta), np.cos(theta)]])
+    rotated = np.stack([rotation @ np.diag([1e-150, 1e150]) @ rotation.T] * 8)
+    with pytest.raises(ValueError, match=r"eigenvalues run from .* to 1e\+150.*1e\+13"):
+        RTWNearestCentroid(manifold="spd", n_epochs=2).fit([rotated, rotated * 2], [0, 1])
+    diagonal = np.stack([np.diag([1e-150 * (1 + t / 10), 1e150]) for t in range(8)])
+    clf = RTWNearestCentroid(manifold="spd", n_epochs=2).fit([diagonal, diagonal * 3], [0, 1])
+    assert clf.predict([diagonal * 3]).tolist() == [1] and np.isfinite(clf.means_).all()

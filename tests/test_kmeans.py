@@ -187,3 +187,33 @@ def test_averager_params_must_be_a_dict():
     X, _ = three_shapes()
     with pytest.raises(TypeError, match="averager_params"):
         RTWKMeans(2, method="dba", averager_params=[("hidden_size", 8)]).fit(X)
+
+
+def test_distances_to_every_centroid_are_features_for_a_pipeline():
+    """RTWAverager(n_centroids=k): one column per centroid (k per class, class of each
+    column in centroid_classes_), usable in a Pipeline and searchable."""
+    from sklearn.linear_model import LogisticRegression
+    from sklearn.pipeline import Pipeline
+
+    X, y = three_shapes()
+    y = np.where(y == 2, 0, y)  # class 0 of two shapes: two centroids capture it
+    averager = RTWAverager(method="dba", n_centroids=2, random_state=0).fit(X, y)
+    features = averager.transform(X)
+    assert features.shape == (len(X), 4) and averager.centroid_classes_.tolist() == [0, 0, 1, 1]
+    # each column is the DTW distance to that centroid
+    from sk_rtw import dtw_distance
+
+    np.testing.assert_allclose(features[3, 1], dtw_distance(X[3], averager.means_[1]))
+    pipe = Pipeline(
+        [
+            ("centroids", RTWAverager(method="dba", n_centroids=2, random_state=0)),
+            ("clf", LogisticRegression(max_iter=1000)),
+        ]
+    ).fit(X, y)
+    assert pipe.score(X, y) == 1.0
+    search = GridSearchCV(pipe, {"centroids__n_centroids": [1, 2]}, cv=3).fit(X, y)
+    assert search.best_params_["centroids__n_centroids"] in (1, 2)
+    assert (
+        search.best_estimator_[0].transform(X).shape[1]
+        == 2 * search.best_params_["centroids__n_centroids"]
+    )

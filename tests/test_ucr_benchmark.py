@@ -108,3 +108,19 @@ def test_missing_values_are_interpolated_and_reported():
     split = load_split("DodgerLoopGame", "train", str(UCR_DIR))
     assert np.isfinite(np.asarray(split.X)).all()
     assert any("interpolation" in note for note in split.notes)
+
+
+@pytest.mark.skipif(not UCR_DIR.is_dir(), reason="needs the UCR development archive")
+@pytest.mark.parametrize("methods", [["dba"], ["rtw", "dba"]])
+def test_one_or_two_methods_finish_with_summary_and_verdict(methods, tmp_path, capsys):
+    """aeon's Friedman test needs three methods: with fewer the diagram is skipped and
+    said so, and the summary and the verdict still come (exit 0)."""
+    out = tmp_path / "results"
+    args = ["--data-dir", str(UCR_DIR), "--datasets", "Chinatown", "ItalyPowerDemand",
+            "Coffee", "BME", "--methods", *methods, "--epochs", "2",
+            "--max-series-per-class", "4", "--out", str(out), "--quiet"]  # fmt: skip
+    assert main(args) == 0
+    printed = capsys.readouterr().out
+    assert "critical-difference diagram not drawn: it needs at least 3 methods" in printed
+    assert "Verdict over 4 dataset(s)" in printed
+    assert (out / "summary.md").is_file() and not (out / "critical_difference.png").exists()

@@ -278,24 +278,42 @@ def scatter_plot(records: list[dict], path: Path) -> bool:
     return True
 
 
-def critical_difference_plot(records: list[dict], methods: list[str], path: Path) -> bool:
+#: aeon's Friedman test needs at least three methods (and three datasets).
+CD_MIN_METHODS = 3
+CD_MIN_DATASETS = 3
+
+
+def critical_difference_plot(records: list[dict], methods: list[str], path: Path) -> str | None:
     """aeon's critical-difference diagram of the accuracies (Wilcoxon, Holm, alpha 0.1).
 
-    Needs at least two methods on at least three datasets where every method ran.
+    Returns None when the diagram was written, else why not: it needs at least
+    :data:`CD_MIN_METHODS` methods on at least :data:`CD_MIN_DATASETS` datasets where every
+    method ran (aeon's Friedman test), aeon and matplotlib.
     """
     names, acc = accuracy_matrix(records, methods)
-    if len(names) < 3 or len(methods) < 2:
-        return False
+    if len(methods) < CD_MIN_METHODS:
+        return (
+            f"it needs at least {CD_MIN_METHODS} methods (aeon's Friedman test), got "
+            f"{len(methods)}"
+        )
+    if len(names) < CD_MIN_DATASETS:
+        return (
+            f"it needs at least {CD_MIN_DATASETS} datasets where every method ran, got "
+            f"{len(names)}"
+        )
     try:
         import matplotlib
 
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
         from aeon.visualisation import plot_critical_difference
-    except ImportError:
-        return False
-    fig, _ = plot_critical_difference(acc, list(methods))
+    except ImportError as exc:
+        return f"{exc.name} is not installed"
+    try:
+        fig, _ = plot_critical_difference(acc, list(methods))
+    except Exception as exc:  # a statistics failure must not lose the summary
+        return f"aeon could not draw it ({type(exc).__name__}: {exc})"
     fig.suptitle(f"Mean rank of nearest-centroid accuracy, {len(names)} UCR datasets", y=1.02)
     fig.savefig(path, dpi=120, bbox_inches="tight")
     plt.close(fig)
-    return True
+    return None

@@ -293,12 +293,17 @@ def main(argv=None) -> int:
     written = [out / "summary.md"]
     if scatter_plot(records, out / "accuracy_scatter.png"):
         written.append(out / "accuracy_scatter.png")
-    if critical_difference_plot(records, list(args.methods), out / "critical_difference.png"):
+    skipped = critical_difference_plot(
+        records, list(args.methods), out / "critical_difference.png"
+    )
+    if skipped is None:
         written.append(out / "critical_difference.png")
     for path in written:
         path.chmod(0o644)
     print(text)
     print("written: " + ", ".join(str(p) for p in written))
+    if skipped is not None:
+        print(f"critical-difference diagram not drawn: {skipped}")
     print("\n".join(verdict(records, list(args.methods))))
     if unavailable:
         print(f"not available offline (skipped): {', '.join(unavailable)}")

@@ -3,9 +3,11 @@
 Besides the distances, the helpers that the DTW-family baselines and the alignment
 engine share: :func:`check_window` (the Sakoe–Chiba argument), :func:`optimal_path` (a
 path through a point-cost matrix), :func:`path_indices` (the path between two series) and
-:func:`medoid_index` (the DTW medoid of a collection).
+:func:`medoid_index` (the DTW medoid of a collection), and :func:`multiscale_path` (a
+coarse-to-fine banded path for long series).
 """
 
+from ._band import multiscale_path
 from ._dtw import (
     check_window,
     dtw_cost_matrix,
@@ -23,6 +25,7 @@ __all__ = [
     "dtw_pairwise_distance",
     "dtw_path",
     "medoid_index",
+    "multiscale_path",
     "optimal_path",
     "path_indices",
     "point_cost_matrix",

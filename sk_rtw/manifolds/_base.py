@@ -111,6 +111,12 @@ class Manifold(ABC):
         return float("inf")
 
     @property
+    @abstractmethod
+    def intrinsic_dim(self) -> int:
+        """Dimension of the manifold: the number of tangent coordinates (2 on S^2, 3 on
+        S^3, ``k (k + 1) / 2`` on SPD(k)), not the size of a point."""
+
+    @property
     def distance_segments(self) -> tuple[tuple[int, int, str], ...] | None:
         """The geodesic distance as ``(start, stop, kind)`` blocks of the flat point.
 
@@ -140,8 +146,15 @@ class Manifold(ABC):
     def _project(self, x: torch.Tensor) -> torch.Tensor: ...
 
     @abstractmethod
-    def _point_problems(self, x: torch.Tensor, atol: float) -> list[tuple[torch.Tensor, str]]:
-        """Per-point boolean masks of violations (over leading axes) with a description."""
+    def _to_coordinates(self, p: torch.Tensor, v: torch.Tensor) -> torch.Tensor: ...
+
+    @abstractmethod
+    def _from_coordinates(self, p: torch.Tensor, c: torch.Tensor) -> torch.Tensor: ...
+
+    @abstractmethod
+    def _point_problems(self, x: torch.Tensor, atol: float) -> list[tuple[torch.Tensor, Any]]:
+        """Per-point boolean masks of violations (over leading axes) with a description
+        (a string, or a callable that describes the first offending point)."""
 
     # ------------------------------------------------------------- public API
     @checked_geometry(points=("p",), vectors=("v",))
@@ -220,6 +233,49 @@ class Manifold(ABC):
         n : same type as the input, shape (...)
         """
         return self._norm(p, v)
+
+    @checked_geometry(points=("p",), vectors=("v",))
+    def to_coordinates(self, p, v):
+        """Coordinates of tangent vectors in an orthonormal basis of the tangent space.
+
+        The basis at ``p`` is orthonormal for the Riemannian metric, so the Euclidean norm
+        of the coordinates is :meth:`norm` ``(p, v)`` and a covariance of coordinates is a
+        covariance of tangent vectors (what Gaussians on manifolds are built from). The
+        basis depends on ``p`` only: compare coordinates at the same point.
+
+        Parameters
+        ----------
+        p : array-like or torch.Tensor, shape (..., *point_shape)
+            Base points.
+        v : array-like or torch.Tensor, shape (..., *point_shape)
+            Tangent vectors at ``p`` (ambient form, as :meth:`log` returns them).
+
+        Returns
+        -------
+        c : same type as the input, shape (..., intrinsic_dim)
+        """
+        return self._to_coordinates(p, v)
+
+    @checked_geometry(points=("p",), broadcast=False)
+    def from_coordinates(self, p, c):
+        """Tangent vectors at ``p`` from their coordinates (inverse of :meth:`to_coordinates`).
+
+        Parameters
+        ----------
+        p : array-like or torch.Tensor, shape (..., *point_shape)
+        c : array-like or torch.Tensor, shape (..., intrinsic_dim)
+
+        Returns
+        -------
+        v : same type as the input, shape (..., *point_shape)
+        """
+        c = c if isinstance(c, torch.Tensor) else torch.as_tensor(np.asarray(c), dtype=p.dtype)
+        if c.shape[-1:] != (self.intrinsic_dim,):
+            raise ValueError(
+                f"coordinates must have {self.intrinsic_dim} entries on the last axis for "
+                f"{self!r}, got shape {tuple(c.shape)}"
+            )
+        return self._from_coordinates(p, c.to(dtype=p.dtype, device=p.device))
 
     @checked_geometry(points=("A", "B"), broadcast=False)
     def pairwise_dist(self, A, B):
@@ -318,13 +374,17 @@ class Manifold(ABC):
             raise ValueError(
                 f"{name} has shape {tuple(X.shape)}, but points of {self!r} have shape {ps}."
             )
-        finite = torch.isfinite(X).reshape(*X.shape[: X.ndim - len(ps)], -1).all(-1)
+        lead = X.ndim - len(ps)
+        finite = torch.isfinite(X).flatten(lead).all(-1) if ps else torch.isfinite(X)
         if not bool(finite.all()):
             idx = _first_index(~finite)
             raise ValueError(f"{name}{idx} contains NaN or infinite values.")
         for mask, description in self._point_problems(X, atol):
             if bool(mask.any()):
                 idx = _first_index(mask)
+                if callable(description):  # a description of the first offending point
+                    first = tuple(torch.nonzero(mask)[0].tolist()) if mask.ndim else ()
+                    description = description(X[first])
                 raise ValueError(
                     f"{name}{idx} is not a point of {self!r}: {description} "
                     f"(tolerance {atol:g}); use {type(self).__name__}.project to map data "
@@ -456,7 +516,10 @@ def _mean_impl(
     X = torch.movedim(X, axis, 0)
     n = X.shape[0]
     if n == 0:
-        raise ValueError("cannot compute the mean of zero samples")
+        raise ValueError(
+            f"cannot compute the mean of zero samples: X has shape {tuple(X.shape)}, with no "
+            f"sample along axis {axis}"
+        )
     if weights is None:
         w = torch.full((n,), 1.0 / n, dtype=X.dtype, device=X.device)
     else:

@@ -35,6 +35,16 @@ class Euclidean(Manifold):
     def distance_segments(self):
         return ((0, self.dim, "euclidean"),)
 
+    @property
+    def intrinsic_dim(self) -> int:
+        return self.dim
+
+    def _to_coordinates(self, p, v):
+        return v + 0.0 * p  # broadcast like the other spaces
+
+    def _from_coordinates(self, p, c):
+        return c + 0.0 * p
+
     def _exp(self, p, v):
         return p + v
 

@@ -52,6 +52,28 @@ class Product(Manifold):
         return min(f.injectivity_radius for f in self.factors)
 
     @property
+    def intrinsic_dim(self) -> int:
+        return sum(f.intrinsic_dim for f in self.factors)
+
+    def _to_coordinates(self, p, v):
+        p, v = torch.broadcast_tensors(p, v)
+        return torch.cat(
+            [f._to_coordinates(a, b)
+             for f, a, b in zip(self.factors, self._split(p), self._split(v), strict=True)],
+            dim=-1,
+        )  # fmt: skip
+
+    def _from_coordinates(self, p, c):
+        lead = torch.broadcast_shapes(p.shape[:-1], c.shape[:-1])
+        p, c = p.expand(*lead, p.shape[-1]), c.expand(*lead, c.shape[-1])
+        parts = torch.split(c, [f.intrinsic_dim for f in self.factors], dim=-1)
+        return self._join(
+            [f._from_coordinates(a, b)
+             for f, a, b in zip(self.factors, self._split(p), parts, strict=True)],
+            self.factors,
+        )  # fmt: skip
+
+    @property
     def distance_segments(self):
         segments, offset = [], 0
         for factor, size in zip(self.factors, self._sizes, strict=True):
@@ -130,10 +152,11 @@ class Product(Manifold):
     def _point_problems(self, x, atol):
         problems = []
         for i, (f, part) in enumerate(zip(self.factors, self._split(x), strict=True)):
-            problems.extend(
-                (mask, f"factor {i} ({f!r}): {text}")
-                for mask, text in f._point_problems(part, atol)
-            )
+            for mask, text in f._point_problems(part, atol):
+                if callable(text):  # describes the factor's part of the first point
+                    problems.append((mask, _factor_text(self, i, f, text)))
+                else:
+                    problems.append((mask, f"factor {i} ({f!r}): {text}"))
         return problems
 
     def _random_point(self, leading, rng):
@@ -148,3 +171,12 @@ class Product(Manifold):
             for f, part in zip(self.factors, parts, strict=True)
         ]
         return np.concatenate(out, axis=-1)
+
+
+def _factor_text(product: Product, i: int, factor: Manifold, describe):
+    """A description of a product point made from its ``i``-th factor's description."""
+
+    def text(point):
+        return f"factor {i} ({factor!r}): {describe(product._split(point)[i])}"
+
+    return text

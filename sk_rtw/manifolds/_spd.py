@@ -12,6 +12,10 @@ from ._base import EXTREME_EXPONENT, Manifold, power_of_two_scale
 from ._euclidean import _check_dim
 from ._symmetric import sym, symmetric_function
 
+#: Largest condition number of a non-diagonal SPD matrix accepted as a point (float64
+#: keeps the smallest eigenvalue to about ``MAX_CONDITION * 2.2e-16`` relative accuracy).
+MAX_CONDITION = 1e13
+
 
 @dataclass(frozen=True)
 class SPD(Manifold):
@@ -37,6 +41,34 @@ class SPD(Manifold):
     @property
     def point_shape(self) -> tuple[int, ...]:
         return (self.dim, self.dim)
+
+    @property
+    def intrinsic_dim(self) -> int:
+        return self.dim * (self.dim + 1) // 2
+
+    def _triangle(self, device):
+        rows, cols = torch.triu_indices(self.dim, self.dim, device=device)
+        return rows, cols
+
+    def _to_coordinates(self, p, v):
+        # pyRiemann's ``upper``: the whitened matrix, diagonal and sqrt(2) x upper triangle
+        si = symmetric_function(p, "invsqrt")
+        w = sym(si @ v @ si)
+        rows, cols = self._triangle(w.device)
+        factor = torch.full(rows.shape, 2.0**0.5, dtype=w.dtype, device=w.device)
+        factor[rows == cols] = 1.0
+        return w[..., rows, cols] * factor
+
+    def _from_coordinates(self, p, c):
+        rows, cols = self._triangle(c.device)
+        factor = torch.full(rows.shape, 2.0**-0.5, dtype=c.dtype, device=c.device)
+        factor[rows == cols] = 1.0
+        lead = torch.broadcast_shapes(p.shape[:-2], c.shape[:-1])
+        w = c.new_zeros(*lead, self.dim, self.dim)
+        w[..., rows, cols] = (c * factor).expand(*lead, c.shape[-1])
+        w = w + w.mT - torch.diag_embed(torch.diagonal(w, dim1=-2, dim2=-1))
+        s = symmetric_function(p, "sqrt")
+        return sym(s @ w @ s)
 
     def _whiten(self, p):
         return symmetric_function(p, "sqrt"), symmetric_function(p, "invsqrt")
@@ -83,9 +115,42 @@ class SPD(Manifold):
         not_symmetric = asymmetry > atol
         w = torch.linalg.eigvalsh(sym(x))
         not_pd = (w[..., 0] <= 0) & ~not_symmetric
+        eye = torch.eye(self.dim, dtype=torch.bool, device=x.device)
+        diagonal = (x.masked_fill(eye, 0.0) == 0).all(-1).all(-1)
+        # a matrix that is not diagonal keeps its eigenvalues in float64 only while they
+        # span fewer than 1 / MAX_CONDITION: below that, the smallest are rounding noise
+        ill = ~not_symmetric & ~not_pd & ~diagonal & (w[..., 0] < w[..., -1] / MAX_CONDITION)
+
+        def eigenvalue_range(point):
+            values = torch.linalg.eigvalsh(sym(point))
+            low, high = float(values[0]), float(values[-1])
+            text = f"its eigenvalues run from {low:.3g} to {high:.3g}"
+            if high > 0 and low > 0:
+                text += f" (condition number {high / low:.3g})"
+            return text
+
         return [
             (not_symmetric, "the matrix is not symmetric"),
-            (not_pd, "the matrix is not positive definite (an eigenvalue is <= 0)"),
+            (
+                not_pd,
+                lambda point: (
+                    "the matrix is not positive definite: "
+                    + eigenvalue_range(point)
+                    + "; a non-diagonal matrix whose true eigenvalues span more than "
+                    f"{MAX_CONDITION:.0e} can get non-positive ones from rounding alone"
+                ),
+            ),
+            (
+                ill,
+                lambda point: (
+                    eigenvalue_range(point)
+                    + f", beyond the condition number {MAX_CONDITION:.0e} up to which a "
+                    "non-diagonal SPD matrix keeps its eigenvalues in float64 (smaller ones "
+                    "are rounding noise and its geometry would be wrong); regularise it (add a "
+                    "multiple of the identity) or pass it in its eigenbasis (diagonal matrices "
+                    "of any conditioning work)"
+                ),
+            ),
         ]
 
     def _random_point(self, leading, rng):

@@ -50,6 +50,27 @@ def _sphere_log(p: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
     return torch.where(antipodal, math.pi * _antipodal_direction(p).expand_as(v), v)
 
 
+def _reflector(p: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+    """Householder vector ``u`` (and ``2 / u.u``) of the reflection that maps the first
+    axis onto ``-+p``: its other columns are an orthonormal basis of the tangent space."""
+    sign = torch.where(p[..., :1] >= 0, 1.0, -1.0)
+    u = p + sign * torch.nn.functional.one_hot(
+        torch.zeros(p.shape[:-1], dtype=torch.long, device=p.device), p.shape[-1]
+    ).to(p.dtype)
+    return u, 2.0 / inner(u, u, keepdim=True)
+
+
+def _sphere_to_coordinates(p: torch.Tensor, v: torch.Tensor) -> torch.Tensor:
+    u, scale = _reflector(p)
+    return (v - scale * inner(u, v, keepdim=True) * u)[..., 1:]
+
+
+def _sphere_from_coordinates(p: torch.Tensor, c: torch.Tensor) -> torch.Tensor:
+    u, scale = _reflector(p)
+    padded = torch.nn.functional.pad(c, (1, 0))
+    return padded - scale * inner(u, padded, keepdim=True) * u
+
+
 def _sphere_dist(p: torch.Tensor, x: torch.Tensor, sign_invariant: bool = False) -> torch.Tensor:
     c = inner(p, x)
     u = x - c.unsqueeze(-1) * p
@@ -90,6 +111,17 @@ class Sphere(Manifold):
     @property
     def distance_segments(self):
         return ((0, self.dim + 1, "sphere"),)
+
+    @property
+    def intrinsic_dim(self) -> int:
+        return self.dim
+
+    def _to_coordinates(self, p, v):
+        return _sphere_to_coordinates(*torch.broadcast_tensors(p, v))
+
+    def _from_coordinates(self, p, c):
+        lead = torch.broadcast_shapes(p.shape[:-1], c.shape[:-1])
+        return _sphere_from_coordinates(p.expand(*lead, p.shape[-1]), c.expand(*lead, c.shape[-1]))
 
     def _exp(self, p, v):
         return _sphere_exp(p, v)
