@@ -15,6 +15,7 @@ from benchmarks.paper._data import (
     quaternion_product,
     track_with_planar_arm,
 )
+from sk_rtw.datasets import make_warped_signals
 
 
 def test_planar_arm_jacobian_matches_finite_differences(rng):
@@ -90,3 +91,33 @@ def test_inverted_s1_runs_the_dtw_baselines(capsys):
     out = capsys.readouterr().out
     for label in ("MMDDTW", "p-DTW", "DBA", "unaligned", "| method | RA | BL | AQ"):
         assert label in out
+
+
+@pytest.mark.parametrize("space", ["pose", "quaternion", "euclidean"])
+def test_imitation_models_reproduce_identical_demonstrations(space):
+    """Three copies of one demonstration: GMR and GP reproduce it, and the DMP is the
+    one-demonstration DMP (the average of identical weights)."""
+    from benchmarks.paper.imitation import POSE, factors, fit_dmp, prepare, reproduce
+    from sk_rtw import dtw_distance
+    from sk_rtw.manifolds import Euclidean, Quaternion
+
+    manifold = {"pose": POSE, "quaternion": Quaternion(), "euclidean": Euclidean(2)}[space]
+    demo = make_warped_signals(manifold, 1, 80, 0, amplitude=0.5).original
+    prepared, mean = prepare("raw", [demo] * 3, manifold, 80, 2, 0)
+    np.testing.assert_allclose(mean, demo, atol=1e-9)
+    for model in ("GMR", "GP"):
+        out = reproduce(model, prepared, manifold, 0)
+        assert out.shape == demo.shape
+        for cols, part in factors(manifold).values():
+            scale = dtw_distance(demo[:, cols], demo[::-1, cols], manifold=part, normalize="path")
+            error = dtw_distance(out[:, cols], demo[:, cols], manifold=part, normalize="path")
+            assert error < 0.05 * scale, (model, error, scale)
+    np.testing.assert_allclose(fit_dmp(prepared, manifold), fit_dmp(prepared[:1], manifold),
+                               atol=1e-9)  # fmt: skip
+    dmp = fit_dmp(prepared, manifold)
+    assert dmp.shape == demo.shape and np.all(np.isfinite(dmp))
+    for cols, part in factors(manifold).values():  # a DMP lags, but follows the shape
+        scale = dtw_distance(demo[:, cols], demo[::-1, cols], manifold=part, normalize="path")
+        assert dtw_distance(dmp[:, cols], demo[:, cols], manifold=part, normalize="path") < (
+            0.3 * scale
+        )
