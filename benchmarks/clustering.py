@@ -15,8 +15,9 @@ Prints
    otherwise).
 2. ``manifolds``: RTWKMeans where no peer runs: RCFS letters on S^2 and S^3, R-LASA shapes
    on S^3 and SPD(2) (demonstrations from ``--demo-dir``), ARI against the shape labels.
-3. ``centroids``: nearest centroid with ``n_centroids`` = 1, 2, 4, 8 DBA centroids per
-   class, and with ``k`` chosen by 3-fold cross-validation on the training split
+3. ``centroids``: nearest centroid with ``n_centroids`` = 1, 2, 4, 8 DBA (or, with
+   ``--centroid-method rtw``, RTW) centroids per class, and with ``k`` chosen by 3-fold
+   cross-validation on the training split
    (``GridSearchCV``), against 1-NN DTW (both with sk_rtw's DTW, absolute point cost):
    test accuracy and prediction seconds per dataset, and the count of datasets where
    the cross-validated ``k`` is at least as accurate as 1-NN DTW.
@@ -144,9 +145,9 @@ def section_manifolds(demo_dir: str | None, epochs: int) -> None:
               flush=True)  # fmt: skip
 
 
-def section_centroids(names, data_dir) -> None:
-    print("\n3. Nearest centroid with k DBA centroids per class vs 1-NN DTW (accuracy; "
-          "prediction seconds)")  # fmt: skip
+def section_centroids(names, data_dir, method="dba") -> None:
+    print(f"\n3. Nearest centroid with k {method.upper()} centroids per class vs 1-NN DTW "
+          "(accuracy; prediction seconds)")  # fmt: skip
     from sklearn.model_selection import GridSearchCV, StratifiedKFold
 
     ks = " ".join(f"{'k=' + str(k):>7}" for k in CENTROIDS)
@@ -158,7 +159,7 @@ def section_centroids(names, data_dir) -> None:
         train, test = load_split(name, "train", data_dir), load_split(name, "test", data_dir)
         accuracy, predict_seconds = {}, {}
         for k in CENTROIDS:
-            clf = RTWNearestCentroid(method="dba", n_centroids=k, random_state=0, n_jobs=-1)
+            clf = RTWNearestCentroid(method=method, n_centroids=k, random_state=0, n_jobs=-1)
             clf.fit(train.X, train.y)
             start = time.perf_counter()
             accuracy[k] = float((clf.predict(test.X) == test.y).mean())
@@ -166,7 +167,7 @@ def section_centroids(names, data_dir) -> None:
         folds = int(min(3, np.bincount(np.unique(train.y, return_inverse=True)[1]).min()))
         if folds >= 2:
             search = GridSearchCV(
-                RTWNearestCentroid(method="dba", random_state=0, n_jobs=-1),
+                RTWNearestCentroid(method=method, random_state=0, n_jobs=-1),
                 {"n_centroids": list(CENTROIDS)},
                 cv=StratifiedKFold(folds, shuffle=True, random_state=0),
             ).fit(train.X, train.y)
@@ -210,6 +211,10 @@ def main(argv=None) -> None:
     parser.add_argument("--demo-dir", help="demonstration data (default ../shared/data)")
     parser.add_argument("--sections", nargs="+", choices=SECTIONS, default=list(SECTIONS))
     parser.add_argument("--epochs", type=int, default=64, help="RTW epochs per centre fit")
+    parser.add_argument(
+        "--centroid-method", default="dba", choices=["dba", "rtw"],
+        help="averaging of the centroids per class (section 3; default dba)",
+    )  # fmt: skip
     args = parser.parse_args(argv)
     warnings.filterwarnings("ignore", module="tslearn")
     if args.datasets:
@@ -223,7 +228,7 @@ def main(argv=None) -> None:
     if "manifolds" in args.sections:
         section_manifolds(args.demo_dir, args.epochs)
     if "centroids" in args.sections:
-        section_centroids(names, args.data_dir)
+        section_centroids(names, args.data_dir, args.centroid_method)
 
 
 if __name__ == "__main__":

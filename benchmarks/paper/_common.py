@@ -22,6 +22,7 @@ from sk_rtw.baselines import dba_average, mmddtw_align, pdtw_average, qdtw_align
 LABELS = {
     "rtw": "RTW",
     "rtw-paper": "RTW (paper)",
+    "rtw-class-means": "RTW (class-means)",
     "ttw-paper": "TTW (paper)",
     "ntw-paper": "NTW (paper)",
     "ttw": "TTW",
@@ -80,12 +81,13 @@ def run_method(
     """Run one method of the paper's tables (or DBA) on the series ``X``.
 
     ``"rtw"``, ``"ttw"``, ``"ntw"`` run the engine with the product defaults, ``"rtw-paper"``
-    (and ``"ttw-paper"``, ``"ntw-paper"``) with ``preset="paper"``.
+    (and ``"ttw-paper"``, ``"ntw-paper"``) with ``preset="paper"``, ``"rtw-class-means"``
+    with the estimators' preset (density-weighted mean on the reference's time axis).
     """
     start = time.perf_counter()
     engine_method, _, variant = method.partition("-")
-    if engine_method in METHODS and variant in ("", "paper"):
-        options = {**ENGINE_OPTIONS, **({"preset": "paper"} if variant else {})}
+    if engine_method in METHODS and variant in ("", "paper", "class-means"):
+        options = {**ENGINE_OPTIONS, **({"preset": variant} if variant else {})}
         r = align(
             X,
             manifold=manifold,

@@ -10,13 +10,14 @@ Data (``../shared/data/icsc_hmm``, read in place): the 12 carrot-grating demonst
 (three groups of four executions, 2322-3371 samples) and the 4 circular-wiping
 demonstrations (1096-1457 samples, whose quaternions flip sign q -> -q 94-140 times; the
 ``Quaternion`` factor's sign-invariant log and distance absorb the flips). Both are
-subsampled (every 10th / 5th sample). Methods: naive interpolation (every series
-resampled to one length, pointwise Fréchet mean), TTW, NTW, RTW, and DBA with Fréchet
-means (not in the paper). Metrics: barycenter loss (BL) and alignment quality (AQ) with
-the pose distance sqrt(|dp|^2 + dist_S3^2) (metres and radians), their position and
-orientation parts, and the speed peak of the mean (largest step over the mean step,
-which the paper uses to say that TTW compresses motion). With ``--figure-dir`` each task
-gets a figure of the mean trajectories with tool frames.
+subsampled (every 10th / 5th sample) unless ``--full-resolution`` is given. Methods:
+naive interpolation (every series resampled to one length, pointwise Fréchet mean),
+TTW, NTW, RTW, and DBA with Fréchet means (not in the paper). Metrics: barycenter loss
+(BL) and alignment quality (AQ) with the pose distance sqrt(|dp|^2 + dist_S3^2) (metres
+and radians), their position and orientation parts, and the speed peak of the mean
+(largest step over the mean step, which the paper uses to say that TTW compresses
+motion). With ``--figure-dir`` each task gets a figure of the mean trajectories with
+tool frames.
 """
 
 from __future__ import annotations
@@ -130,6 +131,10 @@ def main(argv=None) -> None:
     parser.add_argument("--markdown", help="also write the tables to this Markdown file")
     parser.add_argument("--figure-dir", help="write pose_<task>.png figures here")
     parser.add_argument("--quick", action="store_true", help="64 epochs, 4 grating demos")
+    parser.add_argument(
+        "--full-resolution", action="store_true",
+        help="every sample (grating 2,322-3,371, wiping 1,096-1,457) instead of every 10th / 5th",
+    )  # fmt: skip
     args = parser.parse_args(argv)
     apply_engine_options(args)
     root = data_dir(args.data_dir)
@@ -138,14 +143,14 @@ def main(argv=None) -> None:
     sections = {}
     for task in args.tasks:
         loader, step = TASKS[task]
+        step = 1 if args.full_resolution else step
         series = [s[::step] for s in loader(root)]
         if args.quick and task == "grating":
             series = series[::3]
         outcomes, results = evaluate(series, args.methods, args.epochs, args.seed, args.device)
         lengths = sorted(len(s) for s in series)
-        title = (
-            f"{task}: N = {len(series)}, T = {lengths[0]}-{lengths[-1]} (every {step}th sample)"
-        )
+        every = "every sample" if step == 1 else f"every {step}th sample"
+        title = f"{task}: N = {len(series)}, T = {lengths[0]}-{lengths[-1]} ({every})"
         sections[title] = markdown_table({m: [v] for m, v in results.items()}, COLUMNS)
         if args.figure_dir:
             draw(task, series, outcomes, Path(args.figure_dir) / f"pose_{task}.png")

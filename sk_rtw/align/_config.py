@@ -76,10 +76,10 @@ PRESET_DEFAULTS: dict[str, dict[str, Any]] = {
     "alignment": {
         "warp_knots": 64,
         "tangent_refinements": 0,
-        "hidden_size": 64,
+        "hidden_size": 512,
         "mean_iterations": 2,
         "mean_start": "previous",
-        "n_iter_no_change": 10,
+        "n_iter_no_change": 20,
         "tol": 1e-3,
     },
     "paper": {
@@ -91,7 +91,11 @@ PRESET_DEFAULTS: dict[str, dict[str, Any]] = {
         "n_iter_no_change": None,
     },
 }
-PRESET_DEFAULTS["class-means"] = dict(PRESET_DEFAULTS["alignment"])
+PRESET_DEFAULTS["class-means"] = {
+    **PRESET_DEFAULTS["alignment"],
+    "hidden_size": 64,
+    "n_iter_no_change": 10,
+}
 MEAN_STARTS = ("first", "previous")
 #: How the aligned series are weighted in the mean (see :mod:`sk_rtw.align._density`).
 MEAN_WEIGHTS = ("equal", "density")

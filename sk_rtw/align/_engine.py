@@ -209,12 +209,17 @@ def align(
         - ``"ntw"``: neural warps (zero init), full sinc, pointwise loss, penalty;
         - ``"ttw"``: sine-series warps with running-maximum monotonicity, windowed sinc,
           pointwise loss.
-    preset : {"default", "paper"} or None, default=None (``"default"``)
-        ``"paper"``: the paper's configuration (``Z = N T_max``, warps starting at the
-        identity, Xavier-initialised network evaluated at every output time, interpolation
-        tangent point refined twice). ``"default"``: ``Z = min(N, 4) T_max``, network on 64
-        knots, no refinement, and for RTW the DTW start (``warp_start="dtw"``) with a
-        zero-readout network. Explicit arguments override the preset.
+    preset : {"alignment", "class-means", "paper", "default"} or None, default=None
+        None or ``"default"``: ``"alignment"``, ``Z = min(N, 4) T_max``, a warp network of
+        width 512 on 64 knots, no tangent-point refinement, the mean warm-started from the
+        previous epoch, early stopping, and for RTW the DTW start (``warp_start="dtw"``)
+        on the average time axis with a zero-readout network and the paper's equal-weight
+        mean. ``"class-means"`` (the estimators' default): width 64, a quicker stop, and
+        for RTW the density-weighted mean on the reference's time axis (see
+        ``mean_weights`` below). ``"paper"``: the paper's configuration (``Z = N T_max``,
+        warps starting at the identity, Xavier-initialised network evaluated at every
+        output time, interpolation tangent point refined twice, all epochs). Explicit
+        arguments override the preset.
     output_length : int, optional
         Length ``Z`` of the aligned series and mean (preset default: ``min(N, 4) T_max``,
         or ``N T_max`` for the paper).
@@ -255,21 +260,30 @@ def align(
         Print the loss every ``max(1, n_epochs // 10)`` epochs (or every ``verbose``
         epochs when an int > 1).
     **method_options
-        ``n_components`` (TTW sine terms, default 8), ``hidden_size`` (512),
-        ``warp_knots`` (times at which the warp network is evaluated and linearly
-        interpolated between; None evaluates it at every output time as the paper
-        does), ``tangent_refinements`` (Gauss–Newton refinements of the sinc tangent
-        point; 0 uses the centre sample of the window, whose tangent vectors are then
-        computed once per fit), ``mean_iterations`` (Gauss–Newton iterations of the mean
-        per epoch, 5), ``init`` (``"xavier"``, ``"zeros"`` or ``"zero-readout"``),
-        ``dtw_rounds`` (references of the DTW start, 3), ``cuda_graph`` (capture each
-        epoch in a CUDA graph on a CUDA device; off by default, see the GPU guide).
+        ``n_components`` (TTW sine terms, default 8), ``hidden_size`` (width of the warp
+        network, 512; 64 in ``"class-means"``), ``warp_knots`` (times at which the warp
+        network is evaluated and linearly interpolated between; None evaluates it at
+        every output time as the paper does), ``tangent_refinements`` (Gauss–Newton
+        refinements of the sinc tangent point; 0 uses the centre sample of the window,
+        whose tangent vectors are then computed once per fit), ``mean_iterations``
+        (Gauss–Newton steps of the mean per epoch, 2; the paper's 5), ``mean_start``
+        (``"previous"``: from the previous epoch's mean, only the last step
+        differentiated; ``"first"``: the paper's steps from the first series, all
+        differentiated), ``mean_weights`` (``"equal"``: the paper's mean of the aligned
+        series; ``"density"``: every series weighted by the samples each output time
+        covers, see :mod:`sk_rtw.align._density`), ``init`` (``"xavier"``, ``"zeros"`` or
+        ``"zero-readout"``), ``dtw_rounds`` (references of the DTW start, 3), ``smoothing``
+        (Gaussian smoothing of the DTW path warps, in reference samples, 2.0),
+        ``start_axis`` (``"average"`` or ``"reference"``: the time axis of the DTW start),
+        ``cuda_graph`` (capture each epoch in a CUDA graph on a CUDA device; off by
+        default, see the GPU guide).
 
     Returns
     -------
     Alignment
         ``mean`` (Z, *point_shape), ``aligned`` (N, Z, *point_shape), ``warps`` (N, Z),
-        ``loss_history``, ``best_epoch``, ``manifold`` and the resolved ``config``.
+        ``loss_history``, ``best_epoch``, ``n_iter``, ``manifold`` and the resolved
+        ``config``.
 
     Examples
     --------

@@ -40,15 +40,18 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         :class:`TTWAverager`, ...). ``"dba"``: DTW barycenter averaging with Fréchet means
         (:func:`sk_rtw.baselines.dba_average`, squared costs, medoid start), on any
         manifold. Searchable with ``GridSearchCV`` like any parameter.
-    preset : {"default", "paper"} or None, default=None
-        Engine preset (see :func:`sk_rtw.align`): ``"paper"`` is the paper's exact
+    preset : {"class-means", "alignment", "paper", "default"} or None, default=None
+        Engine preset (see :func:`sk_rtw.align`). None or ``"default"``:
+        ``"class-means"``, density-weighted RTW means on the time axis of the DTW
+        reference (what classifies best on the UCR development archive);
+        ``"alignment"``: :func:`sk_rtw.align`'s defaults; ``"paper"``: the paper's exact
         configuration (means of length ``N T_max``, warps starting at the identity).
     output_length : int, optional
-        Length ``Z`` of the means. Default ``T_max``, the length of the longest training
-        series: means longer than the series they are compared with classify worse
-        (:func:`sk_rtw.align.classification_output_length`); the paper preset uses
-        ``N_max T_max`` with ``N_max`` the largest class. Not used by DBA, whose means keep
-        the length of their start (the class medoid).
+        Length ``Z`` of the means. Default: the median length of each class's training
+        series (:func:`sk_rtw.align.classification_output_length`): means longer than
+        the series they are compared with classify worse; the paper preset uses ``N
+        T_max`` per class. Not used by DBA, whose means keep the length of their start
+        (the class medoid).
     n_epochs : int, default=256
         Most Adam epochs per class.
     learning_rate : float, default=0.01
@@ -69,11 +72,16 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         preset's, 0 or 2 for the paper).
     mean_iterations : int or "auto", default="auto"
         Gauss–Newton iterations of the mean per epoch (``"auto"``: the preset's).
+    mean_weights : {"auto", "density", "equal"}, default="auto"
+        How the aligned series enter the class mean: ``"density"`` weighs every series by
+        the samples each output time covers (DBA's counting, for continuous warps; the
+        RTW default of the ``"class-means"`` preset), ``"equal"`` is the paper's mean.
+        Searchable with ``GridSearchCV``.
     n_iter_no_change : int, None or "auto", default="auto"
         Stop a class's training after this many epochs without a relative improvement of
         ``tol`` (None: all ``n_epochs``; ``"auto"``: the preset's).
     tol : float, optional
-        Relative improvement that counts for ``n_iter_no_change`` (default 1e-4).
+        Relative improvement that counts for ``n_iter_no_change`` (the preset's: 1e-3).
     n_centroids : int, default=1
         Centroids per class. Above 1, each class is clustered by k-means (the estimator's
         averaging method, k-means++ seeding, at most 10 rounds; at most one centroid per

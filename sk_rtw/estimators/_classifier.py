@@ -60,8 +60,8 @@ class RTWNearestCentroid(ClassifierMixin, RTWAverager):
     ----------
     manifold, method, preset, output_length, n_epochs, learning_rate, sinc_window, \
 loss_window, loss_step, penalty, warp_start, n_components, hidden_size, warp_knots, \
-tangent_refinements, mean_iterations, n_iter_no_change, tol, dtw_window, n_jobs, \
-random_state, device, verbose
+tangent_refinements, mean_iterations, mean_weights, n_iter_no_change, tol, dtw_window, \
+n_jobs, random_state, device, verbose
         As in :class:`RTWAverager`.
     n_centroids : int, default=1
         Centroids per class, as in :class:`RTWAverager` (k-means within each class); a

@@ -161,8 +161,8 @@ def fit_centres(
     else:
         fitted = _fit_engine(collection, codes, seeds, settings)
         details = [
-            f"best epoch {a.best_epoch + 1} of {a.n_iter} run"
-            for a in fitted  # type: ignore[union-attr]
+            f"best epoch {getattr(a, 'best_epoch', -1) + 1} of {getattr(a, 'n_iter', 0)} run"
+            for a in fitted
         ]
     if settings.verbose:
         seconds = time.perf_counter() - start
