@@ -6,7 +6,8 @@ Usage::
     python benchmarks/align_speed.py --sections fits busy
     python benchmarks/align_speed.py --sections estimators --data-dir ../shared/ucr
     python benchmarks/align_speed.py --sections poses --shared-data ../shared/data
-    python benchmarks/align_speed.py --device cuda      # on a GPU: fits and epochs there
+    python benchmarks/align_speed.py --device cuda --sections fits epochs   # on a GPU
+    python benchmarks/align_speed.py --device cuda --sections fits epochs --cuda-graph
 
 Sections (each number is the median of ``--repeats`` runs after a warm-up run; the
 machine's noise is large, so compare the printed ratios, not absolute seconds):
@@ -131,9 +132,14 @@ def aeon_dba(threads: int, repeats: int, before: str = "") -> float:
     return probe(code, threads, env=environment, replace=True)["seconds"]
 
 
+#: Options added to every engine fit (``--cuda-graph``).
+EXTRA_OPTIONS: dict = {}
+
+
 def engine_fit(space, n, method, threads, repeats, device="cpu", **options) -> dict:
     """One configuration in a fresh process; ``seconds`` is NaN where this version lacks an
     option (older versions have no ``preset="class-means"``)."""
+    options = {**EXTRA_OPTIONS, **options}
     code = f"""
     X = signals({space!r}, {n})
     try:
@@ -389,8 +395,13 @@ def main(argv=None) -> None:
     parser.add_argument(
         "--shared-data", default=None, help="demonstration data (default ../shared/data)"
     )
+    parser.add_argument(
+        "--cuda-graph", action="store_true", help="capture epochs as CUDA graphs (GPU only)"
+    )
     args = parser.parse_args(argv)
-    print(f"machine: {machine(args.device)}")
+    if args.cuda_graph:
+        EXTRA_OPTIONS["cuda_graph"] = True
+    print(f"machine: {machine(args.device)}" + (", CUDA graphs" if args.cuda_graph else ""))
     sections = {"fits": section_fits, "epochs": section_epochs,
                 "estimators": section_estimators, "poses": section_poses,
                 "busy": section_busy}  # fmt: skip

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import platform
 import shlex
 import sys
@@ -151,7 +152,7 @@ def evaluate(
 
 def machine() -> str:
     return (
-        f"{platform.machine()}, {torch.get_num_threads()} torch threads, "
+        f"{platform.machine()}, {os.cpu_count()} cores, fits on one thread (n_jobs=None), "
         f"torch {torch.__version__}, Python {platform.python_version()}"
     )
 

@@ -174,10 +174,10 @@ def fit_centres(
                 file=sys.stderr,
                 flush=True,
             )
+        plural = "es" if kind.endswith("s") else "s"
         print(
-            f"[{settings.owner}] {n_groups} {kind}(es) averaged in {seconds:.1f} s"
-            if kind == "class"
-            else f"[{settings.owner}] {n_groups} {kind}(s) averaged in {seconds:.1f} s",
+            f"[{settings.owner}] {n_groups} {kind}{plural if n_groups != 1 else ''} "
+            f"averaged in {seconds:.1f} s",
             file=sys.stderr,
             flush=True,
         )

@@ -77,8 +77,9 @@ class RTWKMeans(ClusterMixin, TransformerMixin, BaseEstimator):
     verbose : int, default=0
         1: a line per iteration (inertia, changed assignments, time); 2: also per centre.
     averager_params : dict, optional
-        Further :class:`RTWAverager` parameters of the centre fits (``learning_rate``,
-        ``hidden_size``, ``warp_start``, ...).
+        Further engine settings of the centre fits, by their :class:`RTWAverager` names
+        (``learning_rate``, ``hidden_size``, ``warp_start``, ``mean_weights``, ...; an
+        unknown name is a ``TypeError``).
 
     Attributes
     ----------
