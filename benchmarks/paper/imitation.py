@@ -342,8 +342,8 @@ def main(argv=None) -> None:
         "Imitation learning from prepared demonstrations (paper, Tables VII-VIII)",
         "Protocol"
         + __doc__.split("Protocol", 1)[1]
-        + f"\n{args.epochs} epochs for TTW, NTW and RTW; seed {args.seed}. Total time "
-        f"{time.perf_counter() - started:.0f} s.",
+        + f"\nAt most {args.epochs} epochs for TTW, NTW and RTW (early stopping); "
+        f"seed {args.seed}. Total time {time.perf_counter() - started:.0f} s.",
         sections,
     )
 

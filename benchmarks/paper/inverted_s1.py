@@ -131,10 +131,11 @@ def main(argv=None) -> None:
         args.markdown,
         "Inverted time warping on S^1 (paper, section V-B, Tables III and IV)",
         f"""
-{args.epochs} epochs for TTW, NTW and RTW; mean ± std over trials. Columns: restoration
-accuracy (RA), barycenter loss (BL), alignment quality (AQ) as in the paper's eqs. 20a-c,
-each a sum over the N signals of path-normalised geodesic DTW; "RA band" is RA with a
-10 % Sakoe-Chiba band; "warp spread" is zero when the random warps are undone exactly;
+At most {args.epochs} epochs for TTW, NTW and RTW (early stopping); mean ± std over trials.
+Columns: restoration accuracy (RA), barycenter loss (BL), alignment quality (AQ) as in the
+paper's eqs. 20a-c, each a sum over the N signals of path-normalised geodesic DTW; "RA
+band" is RA with a 10 % Sakoe-Chiba band; "warp spread" is zero when the random warps are
+undone exactly;
 lower is better everywhere, the best method per column in bold. "paper" gives the
 paper's RA / BL / AQ / CPU seconds: its DTW normalisation is not published, so compare
 rankings, not values. MMDDTW is the joint DTW over the 4-D grid (sum of pairwise

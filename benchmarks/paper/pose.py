@@ -160,7 +160,8 @@ def main(argv=None) -> None:
         args.markdown,
         "Real pose demonstrations in R^3 x S^3 (paper, section V-D)",
         f"""
-{args.epochs} epochs for TTW, NTW and RTW (Z = min(N, 4) T_max). Barycenter loss (BL) and
+At most {args.epochs} epochs for TTW, NTW and RTW (the defaults stop early; the paper preset runs
+all of them), Z = min(N, 4) T_max. Barycenter loss (BL) and
 alignment quality (AQ) are sums over the N demonstrations of path-normalised DTW with the
 pose distance; "AQ position" (metres) and "AQ orientation" (radians, sign-invariant)
 score the two factors separately; "speed peak" is the largest step of the mean position

@@ -97,7 +97,7 @@ def main(argv=None) -> None:
         f"""
 Barycenter loss (BL) and alignment quality (AQ) as in the paper (sums over the N signals
 of path-normalised DTW with the sign-invariant geodesic distance on S^3; lower is
-better, best in bold), fit seconds; {args.epochs} epochs for RTW (Z = 4T). QDTW is the
+better, best in bold), fit seconds; at most {args.epochs} epochs for RTW (Z = 4T). QDTW is the
 N-signal joint DTW with the sign-invariant geodesic cost; DBA uses Fréchet means (not in
 the paper); "unaligned" resamples every series to one length and averages pointwise.
 "paper" gives Table V (BL / AQ); its DTW normalisation is not published, so compare

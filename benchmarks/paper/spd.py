@@ -144,7 +144,7 @@ def main(argv=None) -> None:
         f"""
 Barycenter loss (BL) and alignment quality (AQ) as in the paper (sums over the N signals
 of path-normalised DTW with the affine-invariant geodesic distance; lower is better,
-best in bold), fit seconds; {args.epochs} epochs for RTW (Z = min(N, 4) T). The
+best in bold), fit seconds; at most {args.epochs} epochs for RTW (Z = min(N, 4) T). The
 paper's arm geometry, masses and DTW normalisation are not published, so its values
 ("paper": BL / AQ) are not comparable with these; compare rankings. "unaligned"
 resamples every series to one length and averages pointwise.
