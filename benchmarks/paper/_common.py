@@ -197,8 +197,10 @@ def markdown_table(
     return "\n".join(lines)
 
 
-def write_markdown(path: str | None, title: str, intro: str, sections: dict[str, str]) -> None:
-    """Print the tables and, with ``path``, write them as a Markdown page."""
+def write_markdown(
+    path: str | None, title: str, intro: str, sections: dict[str, str], quiet: bool = False
+) -> None:
+    """Print the tables (unless ``quiet``) and, with ``path``, write them as a Markdown page."""
     body = [f"# {title}", "", intro.strip(), "", f"Command: `{command_line()}`", ""]
     if ENGINE_OPTIONS:
         body += [f"Engine options for TTW/NTW/RTW: `{json.dumps(ENGINE_OPTIONS)}`.", ""]
@@ -206,7 +208,8 @@ def write_markdown(path: str | None, title: str, intro: str, sections: dict[str,
     for heading, text in sections.items():
         body += [f"## {heading}", "", text.strip(), ""]
     page = "\n".join(body)
-    print(page, flush=True)
+    if not quiet:
+        print(page, flush=True)
     if path:
         Path(path).parent.mkdir(parents=True, exist_ok=True)
         Path(path).write_text(page)

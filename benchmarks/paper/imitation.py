@@ -324,9 +324,28 @@ def main(argv=None) -> None:
         args.epochs = min(args.epochs, 64)
     root = data_dir(args.data_dir)
     started = time.perf_counter()
-    sections = {}
+    selected = [task for task in tasks(root, args.quick) if task in args.tasks]
+    sections: dict[str, str] = {}
+
+    def write(done: bool) -> None:
+        status = (
+            f"Total time {time.perf_counter() - started:.0f} s."
+            if done
+            else f"Partial: {len(sections)} of {len(selected)} tasks done."
+        )
+        write_markdown(
+            args.markdown,
+            "Imitation learning from prepared demonstrations (paper, Tables VII-VIII)",
+            "Protocol"
+            + __doc__.split("Protocol", 1)[1]
+            + f"\nAt most {args.epochs} epochs for TTW, NTW and RTW (early stopping); "
+            f"seed {args.seed}. {status}",
+            sections,
+            quiet=not done,
+        )
+
     for task, (manifold, groups) in tasks(root, args.quick).items():
-        if task not in args.tasks:
+        if task not in selected:
             continue
         result = evaluate(task, manifold, groups, args.preparations, args.models, args)
         sizes = sorted({len(g) for g in groups})
@@ -336,16 +355,11 @@ def main(argv=None) -> None:
             f"on {manifold!r}, T = {lengths[0]}-{lengths[-1]}"
         )
         sections[title] = table(result, args.preparations, args.models)
+        print(f"## {title}\n\n{sections[title]}\n", flush=True)
         print(f"{task}: done", file=sys.stderr, flush=True)
-    write_markdown(
-        args.markdown,
-        "Imitation learning from prepared demonstrations (paper, Tables VII-VIII)",
-        "Protocol"
-        + __doc__.split("Protocol", 1)[1]
-        + f"\nAt most {args.epochs} epochs for TTW, NTW and RTW (early stopping); "
-        f"seed {args.seed}. Total time {time.perf_counter() - started:.0f} s.",
-        sections,
-    )
+        if len(sections) < len(selected):
+            write(done=False)  # a finished task is never lost to a later one's failure
+    write(done=True)
 
 
 if __name__ == "__main__":
