@@ -287,6 +287,19 @@ def test_grid_search_over_methods():
     assert np.isfinite(search.cv_results_["mean_test_score"]).all()
 
 
+def test_grid_search_over_mean_weights():
+    """The class-means choice (density or the paper's equal weights) is a searchable
+    parameter, and it changes the fitted means."""
+    X, y = two_shape_classes(n_per_class=4, length=30)
+    base = RTWNearestCentroid(n_epochs=3, hidden_size=8, random_state=0)
+    search = GridSearchCV(base, {"mean_weights": ["equal", "density"]}, cv=2).fit(X, y)
+    assert [p["mean_weights"] for p in search.cv_results_["params"]] == ["equal", "density"]
+    assert np.isfinite(search.cv_results_["mean_test_score"]).all()
+    equal = clone(base).set_params(mean_weights="equal").fit(X, y)
+    density = clone(base).set_params(mean_weights="density").fit(X, y)
+    assert not np.allclose(np.asarray(equal.means_), np.asarray(density.means_))
+
+
 def test_bad_method_and_preset_are_named():
     X, y = two_shape_classes(n_per_class=2, length=20)
     with pytest.raises(ValueError, match="method must be one of"):
