@@ -300,12 +300,12 @@ def table(result: dict, preparations, models) -> str:
         lines.append("| " + " | ".join(cells) + " |")
     peaks = " / ".join(f"{LABELS.get(p, p)} {result['peaks'][p]:.2f}" for p in preparations)
     times = " / ".join(f"{LABELS.get(p, p)} {result['seconds'][p]:.0f} s" for p in preparations)
-    lines += ["", f"Speed peak of the mean of all demonstrations: {peaks}."]
+    lines += ["", f"- Speed peak of the mean of all demonstrations: {peaks}."]
     for model in models:
         values = " / ".join(f"{LABELS.get(p, p)} {result['reproduction_peaks'][(p, model)]:.2f}"
                             for p in preparations)  # fmt: skip
-        lines.append(f"Speed peak of the {model} reproductions (median over the folds): {values}.")
-    lines.append(f"Preparation time over the folds: {times}.")
+        lines.append(f"- Speed peak of the {model} reproductions (median over folds): {values}.")
+    lines.append(f"- Preparation time over the folds: {times}.")
     return "\n".join(lines)
 
 
