@@ -207,8 +207,7 @@ class AlignedStatistics:
         -------
         distances : ndarray of shape (n, Z)
             ``sqrt(c^T S^-1 c)`` of their coordinates ``c`` at the mean: inside the tube of
-            ``level`` where at
-            most ``tube(level).radius``.
+            ``level`` where at most ``tube(level).radius``.
         """
         aligned = np.asarray(aligned, dtype=np.float64)
         if aligned.ndim != self.mean.ndim + 1 or aligned.shape[1:] != self.mean.shape:
@@ -237,17 +236,15 @@ class AlignedStatistics:
         factors = self.manifold.factors
         if not 0 <= index < len(factors):
             raise IndexError(f"factor index {index} out of range for {len(factors)} factors")
-        sizes = [int(np.prod(f.point_shape)) for f in factors]
         dims = [f.intrinsic_dim for f in factors]
-        start, stop = int(np.sum(sizes[:index])), int(np.sum(sizes[: index + 1]))
-        c0, c1 = int(np.sum(dims[:index])), int(np.sum(dims[: index + 1]))
-        factor = factors[index]
-        mean = self.mean[:, start:stop].reshape(len(self.mean), *factor.point_shape)
+        c0 = sum(dims[:index])
+        c1 = c0 + dims[index]
+        mean = self.manifold._split(torch.as_tensor(self.mean))[index].numpy()
         return AlignedStatistics(
             mean=mean,
             coordinates=self.coordinates[..., c0:c1],
             covariance=self.covariance[:, c0:c1, c0:c1],
-            manifold=factor,
+            manifold=factors[index],
             reg=self.reg,
             ddof=self.ddof,
         )

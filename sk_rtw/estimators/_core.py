@@ -159,11 +159,9 @@ def fit_centres(
             fitted = Parallel(n_jobs=settings.n_jobs)(jobs)
         details = [f"cost {getattr(result, 'cost', float('nan')):.4g}" for result in fitted]
     else:
-        fitted = _fit_engine(collection, codes, seeds, settings)
-        details = [
-            f"best epoch {getattr(a, 'best_epoch', -1) + 1} of {getattr(a, 'n_iter', 0)} run"
-            for a in fitted
-        ]
+        alignments = _fit_engine(collection, codes, seeds, settings)
+        details = [f"best epoch {a.best_epoch + 1} of {a.n_iter} run" for a in alignments]
+        fitted = list(alignments)
     if settings.verbose:
         seconds = time.perf_counter() - start
         sizes = np.bincount(codes, minlength=n_groups)
@@ -186,12 +184,12 @@ def fit_centres(
 
 def _fit_engine(
     collection: SeriesCollection, codes: np.ndarray, seeds: list[int], settings: CentreSettings
-) -> list[Centre]:
+) -> list[Alignment]:
     """The engine's centres: one batched optimisation per distinct output length."""
     n_groups = int(codes.max()) + 1
     lengths = collection.lengths
     z = np.array([settings.output_length_of(lengths[codes == g]) for g in range(n_groups)])
-    fitted: list[Centre | None] = [None] * n_groups
+    fitted: list[Alignment | None] = [None] * n_groups
     for length in np.unique(z):
         groups = np.flatnonzero(z == length)
         members = np.flatnonzero(np.isin(codes, groups))

@@ -46,26 +46,24 @@ class SPD(Manifold):
     def intrinsic_dim(self) -> int:
         return self.dim * (self.dim + 1) // 2
 
-    def _triangle(self, device):
-        rows, cols = torch.triu_indices(self.dim, self.dim, device=device)
-        return rows, cols
+    def _triangle(self, like):
+        """Upper-triangle indices and their weights: 1 on the diagonal, sqrt(2) off it."""
+        rows, cols = torch.triu_indices(self.dim, self.dim, device=like.device)
+        weight = torch.where(rows == cols, 1.0, 2.0**0.5).to(like.dtype)
+        return rows, cols, weight
 
     def _to_coordinates(self, p, v):
         # pyRiemann's ``upper``: the whitened matrix, diagonal and sqrt(2) x upper triangle
         si = symmetric_function(p, "invsqrt")
         w = sym(si @ v @ si)
-        rows, cols = self._triangle(w.device)
-        factor = torch.full(rows.shape, 2.0**0.5, dtype=w.dtype, device=w.device)
-        factor[rows == cols] = 1.0
-        return w[..., rows, cols] * factor
+        rows, cols, weight = self._triangle(w)
+        return w[..., rows, cols] * weight
 
     def _from_coordinates(self, p, c):
-        rows, cols = self._triangle(c.device)
-        factor = torch.full(rows.shape, 2.0**-0.5, dtype=c.dtype, device=c.device)
-        factor[rows == cols] = 1.0
+        rows, cols, weight = self._triangle(c)
         lead = torch.broadcast_shapes(p.shape[:-2], c.shape[:-1])
         w = c.new_zeros(*lead, self.dim, self.dim)
-        w[..., rows, cols] = (c * factor).expand(*lead, c.shape[-1])
+        w[..., rows, cols] = (c / weight).expand(*lead, c.shape[-1])
         w = w + w.mT - torch.diag_embed(torch.diagonal(w, dim1=-2, dim2=-1))
         s = symmetric_function(p, "sqrt")
         return sym(s @ w @ s)
