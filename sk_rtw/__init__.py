@@ -3,7 +3,7 @@
 Align, average and classify time series whose samples live on Riemannian manifolds.
 """
 
-from . import baselines, datasets, metrics, statistics
+from . import baselines, datasets, methods, metrics, statistics
 from .align import Alignment, align
 from .dtw import dtw_cost_matrix, dtw_distance, dtw_pairwise_distance, dtw_path
 from .estimators import (
@@ -23,14 +23,20 @@ from .manifolds import (
     Quaternion,
     Sphere,
     available_manifolds,
+    check_manifold,
     get_manifold,
 )
+from .methods import DBA, NTW, RTW, TTW
 from .statistics import AlignedStatistics, ConfidenceTube, aligned_statistics
 
 __version__ = "0.1.0.dev0"
 
 __all__ = [
+    "DBA",
+    "NTW",
+    "RTW",
     "SPD",
+    "TTW",
     "AlignedStatistics",
     "Alignment",
     "ConfidenceTube",
@@ -51,12 +57,14 @@ __all__ = [
     "aligned_statistics",
     "available_manifolds",
     "baselines",
+    "check_manifold",
     "datasets",
     "dtw_cost_matrix",
     "dtw_distance",
     "dtw_pairwise_distance",
     "dtw_path",
     "get_manifold",
+    "methods",
     "metrics",
     "statistics",
 ]

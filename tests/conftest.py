@@ -36,3 +36,10 @@ def rng() -> np.random.Generator:
 
 def manifold_id(m) -> str:
     return repr(m)
+
+
+def quick(name: str = "rtw", **settings):
+    """A method object for fast tests: 2 epochs, a width-8 network where there is one."""
+    from benchmarks._shared import method_object
+
+    return method_object(name, **{"n_epochs": 2, "hidden_size": 8, **settings})

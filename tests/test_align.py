@@ -399,7 +399,10 @@ def test_very_short_series_work():
         ({"sinc_window": -2}, ValueError, "sinc_window"),
         ({"loss_step": 0}, ValueError, "loss_step"),
         ({"penalty": -1.0}, ValueError, "penalty"),
-        ({"n_components": 0}, ValueError, "n_components"),
+        ({"method": "ttw", "n_components": 0}, ValueError, "n_components"),
+        ({"n_components": 4}, TypeError, "n_components is not a setting of RTW"),
+        ({"method": "ttw", "hidden_size": 8}, TypeError, "it sets RTW, NTW"),
+        ({"sinc_window": "full"}, ValueError, r"None \(the full sinc\)"),
         ({"warp_knots": 1}, ValueError, "warp_knots"),
         ({"tangent_refinements": -1}, ValueError, "tangent_refinements"),
         ({"bogus": 1}, TypeError, "bogus"),
@@ -659,7 +662,8 @@ def test_groups_in_one_batch_equal_separate_fits(method):
 
     series, codes = _groups_data()
     collection = check_series_collection(series, "sphere")
-    config = resolve_config(method, 5, 40, output_length=50, n_epochs=30, method_options={})
+    config = resolve_config(method, "alignment", {"output_length": 50, "n_epochs": 30},
+                            collection.lengths)  # fmt: skip
     # align(random_state=s) seeds its one group with the first draw of default_rng(s)
     seeds = [int(np.random.default_rng(s).integers(2**31 - 1)) for s in (11, 22)]
     batch = align_collection(collection, codes, seeds, config)
@@ -672,39 +676,6 @@ def test_groups_in_one_batch_equal_separate_fits(method):
         np.testing.assert_allclose(batch[g].warps, alone.warps, atol=1e-9)
         np.testing.assert_allclose(batch[g].mean, alone.mean, atol=1e-9)
         np.testing.assert_allclose(batch[g].loss_history, alone.loss_history, rtol=1e-9)
-
-
-def test_group_mean_is_each_groups_frechet_mean(rng):
-    from sk_rtw.align._layout import GroupLayout
-    from sk_rtw.align._means import converged_group_mean, group_mean
-
-    S2 = Sphere(2)
-    points = S2.random_point((7, 4), random_state=1)
-    points = S2.exp(np.tile(points[:1], (7, 1, 1)), 0.3 * S2.random_tangent(
-        np.tile(points[:1], (7, 1, 1)), random_state=2))  # fmt: skip
-    codes = np.array([1, 0, 1, 1, 0, 2, 1])
-    weights = rng.uniform(0.5, 2.0, (7, 4))
-    layout = GroupLayout.from_codes(codes)
-    got = converged_group_mean(S2, torch.as_tensor(points), layout, torch.as_tensor(weights))
-    for g in range(3):
-        idx = codes == g
-        expected = S2.mean(points[idx], weights[idx])
-        np.testing.assert_allclose(got[g].numpy(), expected, atol=1e-9)
-    # flat: the weighted average, whatever the start
-    E = Euclidean(2)
-    x = torch.as_tensor(rng.standard_normal((7, 4, 2)))
-    flat = group_mean(E, x, layout, torch.as_tensor(weights))
-    for g in range(3):
-        idx = torch.as_tensor(codes == g)
-        w = torch.as_tensor(weights)[idx][..., None]
-        torch.testing.assert_close(flat[g], (w * x[idx]).sum(0) / w.sum(0))
-    # the one differentiated step from a converged start has the exact mean's gradient
-    x.requires_grad_(True)
-    (group_mean(E, x, layout, start=flat.detach(), differentiate="last") ** 2).sum().backward()
-    grad_last = x.grad.clone()
-    x.grad = None
-    (group_mean(E, x, layout, differentiate="all") ** 2).sum().backward()
-    torch.testing.assert_close(grad_last, x.grad)
 
 
 def test_group_layout_sums_and_broadcasts():
@@ -762,9 +733,8 @@ def test_density_mean_from_dtw_runs_is_dbas_update(rng):
     """A DTW path matching every mean sample to its own run of series samples: warps read
     off it (no smoothing) give stretches equal to the runs, and the density-weighted mean
     equals DBA's update, the average of every matched sample."""
-    from sk_rtw.align._layout import GroupLayout
-    from sk_rtw.align._means import group_mean
     from sk_rtw.align._start import path_warp
+    from sk_rtw.manifolds._mean import frechet_mean
 
     E = Euclidean(3)
     n_mean = 25
@@ -782,7 +752,7 @@ def test_density_mean_from_dtw_runs_is_dbas_update(rng):
         [path_warp(p, n_mean, len(s), smoothing=0) for p, s in zip(paths, series, strict=True)]
     )
     v, w, _ = _density(E, series, warps)
-    mean = group_mean(E, v, GroupLayout.single(len(series)), w)[0].numpy()
+    mean = frechet_mean(E, v, w)[0].numpy()
     sums, counts = np.zeros((n_mean, 3)), np.zeros(n_mean)
     for p, s in zip(paths, series, strict=True):
         np.add.at(sums, p[:, 0], s[p[:, 1]])

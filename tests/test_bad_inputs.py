@@ -27,6 +27,8 @@ from sk_rtw.baselines import dba_average, mmddtw_align
 from sk_rtw.datasets import make_warped_signals
 from sk_rtw.utils import from_aeon, from_tslearn, to_aeon
 
+from .conftest import quick
+
 RNG = np.random.default_rng(0)
 UNI = RNG.standard_normal((6, 20))  # 6 univariate series
 LABELS = np.array([0, 0, 0, 1, 1, 1])
@@ -34,7 +36,7 @@ S2 = Sphere(2)
 P2 = S2.random_point(5, random_state=1)
 QUAT = make_warped_signals(Quaternion(), 3, 20, 0).signals
 SPD_SERIES = make_warped_signals(SPD(2), 3, 20, 0).signals
-FAST = {"n_epochs": 2, "hidden_size": 8, "random_state": 0}
+FAST = {"method": quick(), "random_state": 0}
 
 
 def fit_classifier(X, y=LABELS, **params):
@@ -259,7 +261,7 @@ ERRORS = [
         ValueError,
         "n_signals",
     ),
-    ("DBA with n_iter=0", lambda: dba_average(UNI, n_iter=0), ValueError, "n_iter"),
+    ("DBA with max_iter=0", lambda: dba_average(UNI, max_iter=0), ValueError, "max_iter"),
     ("aeon conversion of a 2-D array", lambda: from_aeon(np.zeros((3, 5))), ValueError, "3-D"),
     (
         "tslearn array with an empty series",
@@ -420,7 +422,7 @@ def test_spd_beyond_float64_conditioning_is_rejected_with_its_eigenvalues():
     rotation = np.array([[np.cos(theta), -np.sin(theta)], [np.sin(theta), np.cos(theta)]])
     rotated = np.stack([rotation @ np.diag([1e-150, 1e150]) @ rotation.T] * 8)
     with pytest.raises(ValueError, match=r"eigenvalues run from .* to 1e\+150.*1e\+13"):
-        RTWNearestCentroid(manifold="spd", n_epochs=2).fit([rotated, rotated * 2], [0, 1])
+        RTWNearestCentroid(manifold="spd", method=quick()).fit([rotated, rotated * 2], [0, 1])
     diagonal = np.stack([np.diag([1e-150 * (1 + t / 10), 1e150]) for t in range(8)])
-    clf = RTWNearestCentroid(manifold="spd", n_epochs=2).fit([diagonal, diagonal * 3], [0, 1])
+    clf = RTWNearestCentroid(manifold="spd", method=quick()).fit([diagonal, diagonal * 3], [0, 1])
     assert clf.predict([diagonal * 3]).tolist() == [1] and np.isfinite(clf.means_).all()

@@ -18,7 +18,6 @@ from sk_rtw.baselines import (
     qdtw_align,
     quaternion_cost_matrix,
 )
-from sk_rtw.baselines._result import grouped_mean
 from sk_rtw.dtw import dtw_path
 from sk_rtw.manifolds import SPD, Euclidean, Quaternion, Sphere
 from sk_rtw.utils import to_aeon
@@ -186,15 +185,15 @@ def test_dba_matches_aeon_petitjean_on_euclidean_data(rng):
     expected = elastic_barycenter_average(
         to_aeon(X), distance="dtw", max_iters=3, tol=0.0, init_barycenter=init[None]
     )
-    result = dba_average(X, n_iter=3, init=init, tol=0.0)
+    result = dba_average(X, max_iter=3, init=init, tol=0.0)
     np.testing.assert_allclose(result.mean[:, 0], expected.ravel(), rtol=1e-10)
 
 
 def test_dba_cost_never_increases_and_identical_series_are_fixed_points(capsys):
     M = Sphere(2)
     X = np.stack([random_walk(M, 25, s) for s in range(5)])
-    one = dba_average(X, M, n_iter=1)
-    many = dba_average(X, M, n_iter=8, verbose=True)
+    one = dba_average(X, M, max_iter=1)
+    many = dba_average(X, M, max_iter=8, verbose=True)
     costs = [float(line.split()[-1]) for line in capsys.readouterr().err.splitlines()]
     assert costs == sorted(costs, reverse=True) and len(costs) >= 2
     assert many.cost <= one.cost + 1e-12
@@ -212,18 +211,19 @@ def test_dba_on_unequal_lengths_keeps_the_medoid_length():
     assert result.aligned.shape == (3, result.mean.shape[0], 2, 2)
     with pytest.raises(ValueError, match="init"):
         dba_average(X, M, init="mean")
-    with pytest.raises(ValueError, match="n_iter"):
-        dba_average(X, M, n_iter=0)
+    with pytest.raises(ValueError, match="max_iter"):
+        dba_average(X, M, max_iter=0)
 
 
-def test_grouped_mean_equals_one_mean_per_group(rng):
+def test_dba_reports_its_iterations_and_stops_early_when_converged():
     M = Sphere(2)
-    points = random_walk(M, 40, 1)  # clustered, so every mean converges well
-    groups = rng.integers(0, 5, 40)
-    groups[:5] = np.arange(5)
-    result = grouped_mean(M, groups, points, 5)
-    for g in range(5):
-        np.testing.assert_allclose(result[g], M.mean(points[groups == g]), atol=1e-10)
+    X = np.stack([random_walk(M, 25, s) for s in range(5)])
+    short = dba_average(X, M, max_iter=2, tol=0.0)
+    assert short.n_iter == 2
+    converged = dba_average(X, M, max_iter=50, tol=1e-3)
+    assert 1 <= converged.n_iter < 50  # stopped when the cost stopped improving
+    with pytest.raises(ValueError, match="tol"):
+        dba_average(X, M, tol=-1.0)
 
 
 def test_qdtw_is_invariant_to_sign_flips_and_equals_quaternion_dtw(rng):

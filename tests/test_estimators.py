@@ -15,6 +15,9 @@ from sklearn.preprocessing import FunctionTransformer
 from sklearn.utils.estimator_checks import parametrize_with_checks
 
 from sk_rtw import (
+    DBA,
+    RTW,
+    TTW,
     NTWAverager,
     NTWNearestCentroid,
     RTWAverager,
@@ -25,16 +28,17 @@ from sk_rtw import (
 from sk_rtw.datasets import make_warped_signals
 from sk_rtw.manifolds import SPD, Euclidean, Quaternion
 
-FAST = {"n_epochs": 2, "hidden_size": 8, "random_state": 0}
+from .conftest import quick
+
 ESTIMATORS = [
-    cls(**FAST)
-    for cls in (
-        RTWAverager,
-        TTWAverager,
-        NTWAverager,
-        RTWNearestCentroid,
-        TTWNearestCentroid,
-        NTWNearestCentroid,
+    cls(method=quick(name), random_state=0)
+    for cls, name in (
+        (RTWAverager, "rtw"),
+        (TTWAverager, "ttw"),
+        (NTWAverager, "ntw"),
+        (RTWNearestCentroid, "rtw"),
+        (TTWNearestCentroid, "ttw"),
+        (NTWNearestCentroid, "ntw"),
     )
 ] + [RTWNearestCentroid(method="dba"), RTWAverager(method="dba")]
 
@@ -93,20 +97,22 @@ def test_pipeline_gridsearch_clone_pickle_and_cross_validation():
     pipe = Pipeline(
         [
             ("scale", FunctionTransformer(znorm)),
-            ("clf", RTWNearestCentroid(n_epochs=20, hidden_size=32, random_state=0)),
+            ("clf", RTWNearestCentroid(method=RTW(n_epochs=20, hidden_size=32), random_state=0)),
         ]
     )
     assert pipe.fit(X, y).score(X, y) == 1.0
     grid = GridSearchCV(
-        RTWNearestCentroid(n_epochs=10, hidden_size=16, random_state=0),
-        {"loss_window": [0, 5], "manifold": ["euclidean", Euclidean(1)]},
+        RTWNearestCentroid(method=RTW(n_epochs=10, hidden_size=16), random_state=0),
+        {"method__loss_window": [0, 5], "manifold": ["euclidean", Euclidean(1)]},
         cv=2,
     )
     grid.fit(X, y)
-    assert set(grid.best_params_) == {"loss_window", "manifold"}
+    # the searched setting reached the engine of the refitted estimator
+    chosen = grid.best_params_["method__loss_window"]
+    assert grid.best_estimator_.alignments_[0].config.loss_window == chosen
     assert grid.score(X, y) >= 0.9
     scores = cross_val_score(
-        RTWNearestCentroid(n_epochs=10, hidden_size=16, random_state=0), X, y, cv=3
+        RTWNearestCentroid(method=RTW(n_epochs=10, hidden_size=16), random_state=0), X, y, cv=3
     )
     assert scores.mean() >= 0.9
     fitted = pipe.named_steps["clf"]
@@ -118,7 +124,7 @@ def test_pipeline_gridsearch_clone_pickle_and_cross_validation():
 
 def test_outputs_and_probabilities():
     X, y = two_shape_classes()
-    clf = RTWNearestCentroid(n_epochs=15, hidden_size=16, random_state=0).fit(X, y)
+    clf = RTWNearestCentroid(method=RTW(n_epochs=15, hidden_size=16), random_state=0).fit(X, y)
     distances = clf.transform(X)
     assert distances.shape == (12, 2) and np.all(distances >= 0)
     proba = clf.predict_proba(X)
@@ -132,11 +138,11 @@ def test_outputs_and_probabilities():
 
 def test_averager_without_labels_and_with_a_single_series_class():
     X, _ = two_shape_classes(3)
-    averager = RTWAverager(n_epochs=5, hidden_size=8, random_state=0).fit(X)
+    averager = RTWAverager(method=RTW(n_epochs=5, hidden_size=8), random_state=0).fit(X)
     assert averager.means_.shape[0] == 1 and averager.transform(X).shape == (6, 1)
     # Z - 1 = 3 (T - 1): every third output index is a sample of the input
     averager = RTWAverager(
-        n_epochs=5, hidden_size=8, output_length=3 * 39 + 1, random_state=0
+        method=RTW(n_epochs=5, hidden_size=8, output_length=3 * 39 + 1), random_state=0
     ).fit(X, [0] * 5 + [1])
     single = averager.alignments_[1]
     np.testing.assert_allclose(single.warps[0], np.linspace(0, 1, 118))
@@ -145,7 +151,7 @@ def test_averager_without_labels_and_with_a_single_series_class():
 
 def test_fit_transform_equals_fit_then_transform():
     X, y = two_shape_classes(3)
-    est = RTWAverager(n_epochs=3, hidden_size=8, random_state=0)
+    est = RTWAverager(method=RTW(n_epochs=3, hidden_size=8), random_state=0)
     np.testing.assert_allclose(est.fit_transform(X, y), clone(est).fit(X, y).transform(X))
 
 
@@ -153,7 +159,7 @@ def test_fit_transform_equals_fit_then_transform():
 def test_string_integer_and_mixed_labels(labels):
     X, y = two_shape_classes(4)
     y = [labels[0] if v == "sine" else labels[1] for v in y]
-    clf = RTWNearestCentroid(n_epochs=10, hidden_size=16, random_state=0).fit(X, y)
+    clf = RTWNearestCentroid(method=RTW(n_epochs=10, hidden_size=16), random_state=0).fit(X, y)
     assert set(clf.classes_.tolist()) == set(labels)
     assert np.mean(clf.predict(X) == np.array(y, dtype=object)) >= 0.9
 
@@ -161,7 +167,8 @@ def test_string_integer_and_mixed_labels(labels):
 def test_unequal_lengths_and_other_test_lengths():
     X, y = two_shape_classes(4, length=50)
     ragged = [x[: 50 - 3 * (i % 4)] for i, x in enumerate(X)]
-    clf = RTWNearestCentroid(n_epochs=10, hidden_size=16, random_state=0).fit(ragged, y)
+    clf = RTWNearestCentroid(method=RTW(n_epochs=10, hidden_size=16), random_state=0)
+    clf.fit(ragged, y)
     X_test, y_test = two_shape_classes(3, length=35, seed=1)
     assert np.mean(clf.predict(X_test) == y_test) >= 0.8
 
@@ -174,7 +181,8 @@ def test_separates_two_manifold_shapes(name, manifold):
         X.extend(data.signals)
         y.extend([label] * 5)
     X = np.stack(X)
-    clf = RTWNearestCentroid(manifold=name, n_epochs=20, hidden_size=16, random_state=0)
+    clf = RTWNearestCentroid(manifold=name, method=RTW(n_epochs=20, hidden_size=16),
+                             random_state=0)  # fmt: skip
     clf.fit(X[::2], np.array(y)[::2])
     assert np.mean(clf.predict(X[1::2]) == np.array(y)[1::2]) == 1.0
     manifold.validate(clf.means_, atol=1e-8)
@@ -182,28 +190,29 @@ def test_separates_two_manifold_shapes(name, manifold):
 
 def test_same_random_state_same_means():
     X, y = two_shape_classes(3)
-    a = RTWAverager(n_epochs=5, hidden_size=8, random_state=3).fit(X, y)
-    b = RTWAverager(n_epochs=5, hidden_size=8, random_state=3).fit(X, y)
+    a = RTWAverager(method=RTW(n_epochs=5, hidden_size=8), random_state=3).fit(X, y)
+    b = RTWAverager(method=RTW(n_epochs=5, hidden_size=8), random_state=3).fit(X, y)
     np.testing.assert_array_equal(a.means_, b.means_)
 
 
 def test_parallel_classes_equal_sequential():
     X, y = two_shape_classes(3)
-    a = RTWAverager(n_epochs=5, hidden_size=8, random_state=3).fit(X, y)
-    b = RTWAverager(n_epochs=5, hidden_size=8, random_state=3, n_jobs=2).fit(X, y)
+    a = RTWAverager(method=RTW(n_epochs=5, hidden_size=8), random_state=3).fit(X, y)
+    b = RTWAverager(method=RTW(n_epochs=5, hidden_size=8), random_state=3, n_jobs=2).fit(X, y)
     np.testing.assert_allclose(a.means_, b.means_, atol=1e-10)
 
 
 def test_named_estimators_use_their_engine():
     X, y = two_shape_classes(3)
     for cls, method in ((TTWAverager, "ttw"), (NTWNearestCentroid, "ntw")):
-        est = cls(n_epochs=2, hidden_size=8, random_state=0).fit(X, y)
+        assert cls().method == method  # the class's own default
+        est = cls(method=quick(method), random_state=0).fit(X, y)
         assert {a.config.method for a in est.alignments_} == {method}
 
 
 def test_verbose_reports_classes(capsys):
     X, y = two_shape_classes(2)
-    RTWAverager(n_epochs=2, hidden_size=8, verbose=1).fit(X, y)
+    RTWAverager(method=quick(), verbose=1).fit(X, y)
     assert "class 'bump'" in capsys.readouterr().err
 
 
@@ -222,7 +231,7 @@ def test_verbose_reports_classes(capsys):
 def test_bad_input(X, y, match):
     manifold = "sphere" if np.asarray(X).ndim == 3 else "euclidean"
     with pytest.raises(ValueError, match=match):
-        RTWNearestCentroid(manifold=manifold, **FAST).fit(X, y)
+        RTWNearestCentroid(manifold=manifold, method=quick(), random_state=0).fit(X, y)
 
 
 def test_predict_before_fit():
@@ -241,15 +250,16 @@ def test_predict_before_fit():
         (NTWNearestCentroid(), "ntw"),
         (TTWNearestCentroid(method="dba"), "dba"),
         (RTWNearestCentroid(method="NTW"), "ntw"),
+        (RTWNearestCentroid(method=TTW(n_epochs=2)), "ttw"),
     ],
 )
-def test_method_none_is_the_classes_own_and_any_method_can_be_chosen(estimator, method):
+def test_the_class_default_is_its_own_method_and_any_method_can_be_chosen(estimator, method):
     X, y = two_shape_classes(n_per_class=3, length=30)
-    estimator.set_params(n_epochs=2, hidden_size=8, random_state=0)
-    fitted = estimator.fit(X, y)
+    if isinstance(estimator.method, str) and estimator.method.lower() != "dba":
+        estimator.set_params(method=quick(estimator.method.lower()))
+    fitted = estimator.set_params(random_state=0).fit(X, y)
     assert fitted.method_ == method
-    if method != "dba":
-        assert all(a.config.method == method for a in fitted.alignments_)
+    assert all(a.config.method == method for a in fitted.alignments_)
 
 
 def test_dba_method_equals_the_baseline_per_class():
@@ -276,27 +286,35 @@ def test_dba_on_a_manifold_and_on_unequal_lengths():
     assert unequal.predict(series).tolist() == [0, 0, 1, 1]
 
 
-def test_grid_search_over_methods():
+def test_grid_search_reaches_the_method_and_the_preset():
+    """A scorer that reads what was fitted (not the accuracy): each candidate's score
+    proves that its method and preset reached the fit."""
     X, y = two_shape_classes(n_per_class=4, length=30)
+
+    def fitted_with(estimator, X, y):
+        config = estimator.alignments_[0].config
+        return float(estimator.method_ == "dba") + 0.5 * float(config.preset == "paper")
+
     search = GridSearchCV(
-        RTWNearestCentroid(n_epochs=3, hidden_size=8, random_state=0),
-        {"method": ["rtw", "dba"], "preset": [None, "paper"]},
-        cv=2,
-    ).fit(X, y)
-    assert search.best_params_["method"] in ("rtw", "dba")
-    assert np.isfinite(search.cv_results_["mean_test_score"]).all()
+        RTWNearestCentroid(method=quick(), random_state=0),
+        {"method": [quick("rtw"), DBA()], "preset": ["class-means", "paper"]},
+        cv=2, scoring=fitted_with,
+    ).fit(X, y)  # fmt: skip
+    np.testing.assert_array_equal(search.cv_results_["mean_test_score"], [0.0, 0.5, 1.0, 1.5])
+    assert isinstance(search.best_params_["method"], DBA)
 
 
 def test_grid_search_over_mean_weights():
     """The class-means choice (density or the paper's equal weights) is a searchable
-    parameter, and it changes the fitted means."""
+    setting of the method, and it changes the fitted means."""
     X, y = two_shape_classes(n_per_class=4, length=30)
-    base = RTWNearestCentroid(n_epochs=3, hidden_size=8, random_state=0)
-    search = GridSearchCV(base, {"mean_weights": ["equal", "density"]}, cv=2).fit(X, y)
-    assert [p["mean_weights"] for p in search.cv_results_["params"]] == ["equal", "density"]
+    base = RTWNearestCentroid(method=RTW(n_epochs=3, hidden_size=8), random_state=0)
+    search = GridSearchCV(base, {"method__mean_weights": ["equal", "density"]}, cv=2).fit(X, y)
     assert np.isfinite(search.cv_results_["mean_test_score"]).all()
-    equal = clone(base).set_params(mean_weights="equal").fit(X, y)
-    density = clone(base).set_params(mean_weights="density").fit(X, y)
+    equal = clone(base).set_params(method__mean_weights="equal").fit(X, y)
+    density = clone(base).set_params(method__mean_weights="density").fit(X, y)
+    assert equal.alignments_[0].config.mean_weights == "equal"
+    assert density.alignments_[0].config.mean_weights == "density"
     assert not np.allclose(np.asarray(equal.means_), np.asarray(density.means_))
 
 

@@ -8,11 +8,13 @@ from sklearn.metrics import adjusted_rand_score
 from sklearn.model_selection import GridSearchCV
 from sklearn.utils.estimator_checks import parametrize_with_checks
 
-from sk_rtw import RTWAverager, RTWKMeans, RTWNearestCentroid
+from sk_rtw import DBA, RTW, RTWAverager, RTWKMeans, RTWNearestCentroid
+from sk_rtw.baselines import dba_average
 from sk_rtw.datasets import make_warped_signals
 from sk_rtw.estimators._core import fill_empty as _fill_empty
 from sk_rtw.manifolds import Sphere
 
+from .conftest import quick
 from .test_estimators import EXPECTED_FAILURES
 
 
@@ -44,7 +46,7 @@ def three_shapes(manifold="euclidean", n_per=6, length=40, seed=0):
 
 @parametrize_with_checks(
     [RTWKMeans(n_clusters=2, method="dba", random_state=0),
-     RTWKMeans(n_clusters=2, n_epochs=2, max_iter=2, random_state=0)],
+     RTWKMeans(n_clusters=2, method=quick(), max_iter=2, random_state=0)],
     expected_failed_checks=lambda est: EXPECTED_FAILURES,
 )  # fmt: skip
 def test_sklearn_compatible(estimator, check):
@@ -54,7 +56,8 @@ def test_sklearn_compatible(estimator, check):
 @pytest.mark.parametrize("method", ["dba", "rtw"])
 def test_recovers_warped_copies_of_three_shapes(method):
     X, y = three_shapes()
-    km = RTWKMeans(3, method=method, n_epochs=32, n_init=2, random_state=0).fit(X)
+    km = RTWKMeans(3, method=quick(method, n_epochs=32, hidden_size=64), n_init=2,
+                   random_state=0).fit(X)  # fmt: skip
     assert adjusted_rand_score(y, km.labels_) == 1.0
     assert km.cluster_centers_.shape == (3, 40, 1)
     np.testing.assert_array_equal(km.predict(X), km.labels_)
@@ -134,12 +137,15 @@ def test_bad_parameters_are_named(params, match):
 # ---------------------------------------------------------- several centroids per class
 
 
-def test_one_centroid_per_class_is_the_plain_classifier():
+def test_one_centroid_per_class_is_each_classs_mean():
+    """n_centroids=1 (the default) averages each class once, with no clustering: the
+    means are the DBA baseline of every class, each series assigned to its own class."""
     X, y = three_shapes()
-    plain = RTWNearestCentroid(method="dba", random_state=0).fit(X, y)
     one = RTWNearestCentroid(method="dba", n_centroids=1, random_state=0).fit(X, y)
-    np.testing.assert_array_equal(plain.means_, one.means_)
+    for k in range(3):
+        np.testing.assert_allclose(one.means_[k], dba_average(X[y == k]).mean, atol=1e-12)
     np.testing.assert_array_equal(one.centroid_classes_, [0, 1, 2])
+    np.testing.assert_array_equal(one.assignments_, y)
 
 
 def test_several_centroids_capture_a_class_made_of_two_shapes():
@@ -157,21 +163,29 @@ def test_several_centroids_capture_a_class_made_of_two_shapes():
 
 
 def test_n_centroids_is_searchable_and_validated():
-    X, y = three_shapes()
+    X, labels = three_shapes()
+    y = np.where(labels == 2, 0, labels)  # class 0 of two shapes
+
+    def centroids_fitted(estimator, X, y):  # what the candidate fitted, not its accuracy
+        return float(len(estimator.means_))
+
     search = GridSearchCV(
-        RTWNearestCentroid(method="dba", random_state=0), {"n_centroids": [1, 2]}, cv=2
-    ).fit(X, y)
-    assert search.best_params_["n_centroids"] in (1, 2)
+        RTWNearestCentroid(method="dba", random_state=0), {"n_centroids": [1, 2]}, cv=2,
+        scoring=centroids_fitted,
+    ).fit(X, y)  # fmt: skip
+    np.testing.assert_array_equal(search.cv_results_["mean_test_score"], [2.0, 4.0])
+    assert search.best_params_ == {"n_centroids": 2}
     with pytest.raises(ValueError, match="n_centroids"):
         RTWNearestCentroid(method="dba", n_centroids=0).fit(X, y)
-    few = RTWNearestCentroid(method="dba", n_centroids=10).fit(X, y)  # capped per class
+    few = RTWNearestCentroid(method="dba", n_centroids=10).fit(X, labels)  # capped per class
     assert len(few.means_) == 18
 
 
 def test_centroids_per_class_use_the_classifiers_engine_settings():
     X, y = three_shapes()
     clf = RTWNearestCentroid(
-        n_centroids=2, n_epochs=2, hidden_size=8, learning_rate=0.05, warp_start="identity"
+        method=RTW(n_epochs=2, hidden_size=8, learning_rate=0.05, warp_start="identity"),
+        n_centroids=2,
     ).fit(X, y)
     assert len(clf.alignments_) == len(clf.means_) == 6
     for fit in clf.alignments_:
@@ -183,10 +197,18 @@ def test_centroids_per_class_use_the_classifiers_engine_settings():
     assert np.array_equal(clf.centroid_classes_[clf.assignments_], codes)
 
 
-def test_averager_params_must_be_a_dict():
+def test_centroid_settings_belong_to_the_method_and_are_checked():
     X, _ = three_shapes()
-    with pytest.raises(TypeError, match="averager_params"):
-        RTWKMeans(2, method="dba", averager_params=[("hidden_size", 8)]).fit(X)
+    with pytest.raises(TypeError, match="method=RTW"):
+        RTWKMeans(2, averager_params={"hidden_size": 8})
+    with pytest.raises(TypeError, match="not of DBA"):
+        RTWKMeans(2, method=DBA(n_epochs=3))
+    with pytest.raises(ValueError, match="n_epochs"):
+        RTWKMeans(2, method=RTW(n_epochs=-1)).fit(X)
+    with pytest.raises(ValueError, match="max_iter"):
+        RTWKMeans(2, method=DBA(max_iter=0)).fit(X)
+    km = RTWKMeans(2, method=RTW(n_epochs=3, hidden_size=8), random_state=0).fit(X)
+    assert {fit.config.hidden_size for fit in km.alignments_} == {8}
 
 
 def test_distances_to_every_centroid_are_features_for_a_pipeline():
@@ -212,8 +234,5 @@ def test_distances_to_every_centroid_are_features_for_a_pipeline():
     ).fit(X, y)
     assert pipe.score(X, y) == 1.0
     search = GridSearchCV(pipe, {"centroids__n_centroids": [1, 2]}, cv=3).fit(X, y)
-    assert search.best_params_["centroids__n_centroids"] in (1, 2)
-    assert (
-        search.best_estimator_[0].transform(X).shape[1]
-        == 2 * search.best_params_["centroids__n_centroids"]
-    )
+    k = search.best_params_["centroids__n_centroids"]
+    assert search.best_estimator_[0].transform(X).shape[1] == 2 * k  # the searched k reached it

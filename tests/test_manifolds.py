@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import pickle
+from dataclasses import dataclass
 
 import numpy as np
 import pytest
@@ -11,14 +12,18 @@ import scipy.linalg
 import torch
 from sklearn.base import BaseEstimator, clone
 
+from sk_rtw import RTWNearestCentroid, align
+from sk_rtw.datasets import make_warped_signals
 from sk_rtw.manifolds import (
     SPD,
     Euclidean,
     Manifold,
+    ManifoldCheckError,
     Product,
     Quaternion,
     Sphere,
     available_manifolds,
+    check_manifold,
     get_manifold,
 )
 
@@ -375,3 +380,78 @@ def test_sum_last_and_inner_equal_torch_sums(shape):
     torch.testing.assert_close(inner(x, y), (x * y).sum(-1))
     (grad,) = torch.autograd.grad(inner(x, y).sum(), x)
     torch.testing.assert_close(grad, y)
+
+
+# ------------------------------------------------------------ check_manifold (public)
+@parametrize_manifolds
+def test_check_manifold_passes_every_space_of_the_package(M):
+    passed = check_manifold(M)
+    assert "log inverts exp" in passed and "finite gradients" in passed
+
+
+@dataclass(frozen=True)
+class PlaneRotations(Manifold):
+    """SO(2) as 2x2 rotation matrices, from exp and log only (the rest derived)."""
+
+    @property
+    def point_shape(self):
+        return (2, 2)
+
+    @property
+    def injectivity_radius(self):
+        return math.pi
+
+    def _exp(self, R, V):
+        angle = (R.transpose(-1, -2) @ V)[..., 1, 0]
+        c, s = torch.cos(angle), torch.sin(angle)
+        return R @ torch.stack([torch.stack([c, -s], -1), torch.stack([s, c], -1)], -2)
+
+    def _log(self, R, S):
+        Q = R.transpose(-1, -2) @ S
+        angle = torch.atan2(Q[..., 1, 0], Q[..., 0, 0])
+        zero = torch.zeros_like(angle)
+        skew = torch.stack([torch.stack([zero, -angle], -1), torch.stack([angle, zero], -1)], -2)
+        return R @ skew
+
+
+def rotations(angles):
+    c, s = np.cos(angles), np.sin(angles)
+    return np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)
+
+
+def test_a_space_written_with_exp_and_log_only_is_checked_aligned_and_classified():
+    SO2 = PlaneRotations()
+    angles = np.random.default_rng(0).uniform(-2.5, 2.5, 8)
+    passed = check_manifold(SO2, rotations(angles))
+    assert len(passed) == 14  # every property; tangent coordinates skipped (not defined)
+    # distance derived as the norm of the log: sqrt(2) times the angle between rotations
+    assert SO2.dist(rotations(0.1), rotations(0.6)) == pytest.approx(np.sqrt(2) * 0.5)
+    # the same demonstrations as unit vectors of S^1: the same geometry, the same mean
+    data = make_warped_signals(Sphere(1), 3, 30, random_state=1)
+    theta = np.arctan2(data.signals[..., 1], data.signals[..., 0])
+    as_matrices = align(rotations(theta), manifold=SO2, n_epochs=0, random_state=0)
+    as_circle = align(data.signals, manifold=Sphere(1), n_epochs=0, random_state=0)
+    mean_angle = np.arctan2(as_matrices.mean[:, 1, 0], as_matrices.mean[:, 0, 0])
+    circle_angle = np.arctan2(as_circle.mean[:, 1], as_circle.mean[:, 0])
+    np.testing.assert_allclose(mean_angle, circle_angle, atol=1e-8)
+    labels = [0, 0, 0, 1, 1, 1]
+    X = np.concatenate([rotations(theta), rotations(theta[:, ::-1])])
+    clf = RTWNearestCentroid(manifold=SO2, method="dba").fit(X, labels)
+    assert clf.score(X, labels) == 1.0
+
+
+def test_check_manifold_names_the_broken_property():
+    class WrongLog(Sphere):
+        def _log(self, p, x):
+            return 1.1 * super()._log(p, x)
+
+    class LeavesTheSphere(Sphere):
+        def _exp(self, p, v):
+            return p + v
+
+    with pytest.raises(ManifoldCheckError, match=r"WrongLog.*'log inverts exp'"):
+        check_manifold(WrongLog(2))
+    with pytest.raises(ManifoldCheckError, match="'exp lands on the manifold'"):
+        check_manifold(LeavesTheSphere(2))
+    with pytest.raises(TypeError, match="pass points="):
+        check_manifold(PlaneRotations())

@@ -17,8 +17,10 @@ import numpy as np
 import torch
 
 from sk_rtw import align, metrics
-from sk_rtw.align import METHODS
+from sk_rtw.align import ENGINE_METHODS
 from sk_rtw.baselines import dba_average, mmddtw_align, pdtw_average, qdtw_align
+
+from .._shared import method_object
 
 LABELS = {
     "rtw": "RTW",
@@ -48,13 +50,26 @@ def add_engine_options(parser: argparse.ArgumentParser) -> None:
         "--options",
         type=json.loads,
         default={},
-        help="extra sk_rtw.align options for TTW/NTW/RTW as JSON, e.g. "
-        '\'{"warp_knots": null, "tangent_refinements": 2}\' (network at every output time, '
-        "refined tangent points)",
+        help="extra sk_rtw.align settings for TTW/NTW/RTW as JSON, each applied to the "
+        'methods that have it, e.g. \'{"warp_knots": null, "tangent_refinements": 2}\' '
+        "(network at every output time, refined tangent points)",
     )
 
 
 def apply_engine_options(args: argparse.Namespace) -> None:
+    """Check ``--options`` against the knob table (names and values) before any work."""
+    from sk_rtw.align import KNOBS
+    from sk_rtw.align._config import knob_parameter
+
+    if not isinstance(args.options, dict):
+        raise SystemExit(f"error: --options must be a JSON object, got {args.options!r}")
+    for name, value in args.options.items():
+        if name not in KNOBS:
+            raise SystemExit(f"error: --options: {name!r} is no setting (known: {sorted(KNOBS)})")
+        try:
+            knob_parameter(name).check(value)
+        except ValueError as exc:
+            raise SystemExit(f"error: --options: {exc}") from None
     ENGINE_OPTIONS.clear()
     ENGINE_OPTIONS.update(args.options)
 
@@ -87,17 +102,16 @@ def run_method(
     """
     start = time.perf_counter()
     engine_method, _, variant = method.partition("-")
-    if engine_method in METHODS and variant in ("", "paper", "class-means"):
-        options = {**ENGINE_OPTIONS, **({"preset": variant} if variant else {})}
+    if engine_method in ENGINE_METHODS and variant in ("", "paper", "class-means"):
+        lengths = {} if output_length is None else {"output_length": output_length}
+        settings = method_object(engine_method, **ENGINE_OPTIONS, n_epochs=epochs, **lengths)
         r = align(
             X,
             manifold=manifold,
-            method=engine_method,
-            n_epochs=epochs,
-            output_length=output_length,
+            method=settings,
+            preset=variant or "alignment",
             random_state=seed,
             device=device,
-            **options,
         )
     elif method == "mmddtw":
         r = mmddtw_align(X, manifold)

@@ -5,8 +5,8 @@ For one dataset and each method:
 1. the class means from the training series of each class: ``rtw``, ``ttw``, ``ntw``,
    ``dba`` are :class:`sk_rtw.RTWNearestCentroid` with that ``method`` (product defaults),
    ``rtw-paper`` is RTW with ``preset="paper"``, ``rtw-equal`` RTW with the paper's
-   equal-weight mean, ``rtw-alignment`` RTW with ``preset="alignment"`` (align's
-   defaults); ``aeon-dba`` is aeon's
+   equal-weight mean (``method=RTW(mean_weights="equal")``), ``rtw-alignment`` RTW with
+   ``preset="alignment"`` (align's defaults, means of ``min(N, 4) T``); ``aeon-dba`` is aeon's
    ``elastic_barycenter_average`` with DTW (a reference where the data are Euclidean);
 2. averaging values, per training series: ``alignment`` = DTW of the *warped* (aligned)
    series to its class mean (the paper's averaging score; not for aeon's DBA) and
@@ -40,25 +40,26 @@ from pathlib import Path
 import numpy as np
 from scipy import stats
 
-from sk_rtw import RTWNearestCentroid, dtw_pairwise_distance
+from sk_rtw import Alignment, RTWNearestCentroid, dtw_pairwise_distance
 from sk_rtw.utils import to_aeon
 
+from .._shared import method_object
 from ._data import load_split, subsample_per_class, take
 
 ALPHA = 0.05
 #: Result files are readable by everyone (rw-r--r--), like any file the user writes.
 FILE_MODE = 0o644
-#: Rows computed by the product's estimator, with its parameters.
-ESTIMATOR_METHODS = {
-    "rtw": {"method": "rtw"},
-    "rtw-paper": {"method": "rtw", "preset": "paper"},
+#: Rows computed by the product's estimator: the method, its settings, the preset.
+ESTIMATOR_METHODS: dict[str, tuple[str, dict, str]] = {
+    "rtw": ("rtw", {}, "class-means"),
+    "rtw-paper": ("rtw", {}, "paper"),
     # ablations of the class-means preset: the paper's equal-weight mean, and align's
-    # defaults (equal weights on the average time axis, 3 start rounds)
-    "rtw-equal": {"method": "rtw", "mean_weights": "equal"},
-    "rtw-alignment": {"method": "rtw", "preset": "alignment"},
-    "ttw": {"method": "ttw"},
-    "ntw": {"method": "ntw"},
-    "dba": {"method": "dba"},
+    # defaults (equal weights on the average time axis, 3 start rounds, Z = min(N, 4) T)
+    "rtw-equal": ("rtw", {"mean_weights": "equal"}, "class-means"),
+    "rtw-alignment": ("rtw", {}, "alignment"),
+    "ttw": ("ttw", {}, "class-means"),
+    "ntw": ("ntw", {}, "class-means"),
+    "dba": ("dba", {}, "class-means"),
 }
 REFERENCE_METHODS = ("aeon-dba", "1nn-dtw")
 ALL_METHODS = (*ESTIMATOR_METHODS, *REFERENCE_METHODS)
@@ -104,15 +105,22 @@ def _class_members(y, classes):
     return [np.flatnonzero(y == c) for c in classes]
 
 
-def _fit_estimator(method, train, test, config):
-    estimator = RTWNearestCentroid(
-        **ESTIMATOR_METHODS[method],
-        n_epochs=config.epochs,
-        output_length=config.output_length,
+def make_estimator(row: str, config: RunConfig) -> RTWNearestCentroid:
+    """The estimator of one row, with the run's epochs, output length, seed and device."""
+    name, settings, preset = ESTIMATOR_METHODS[row]
+    lengths = {} if config.output_length is None else {"output_length": config.output_length}
+    method = method_object(name, **settings, n_epochs=config.epochs, **lengths)
+    return RTWNearestCentroid(
+        method=method,
+        preset=preset,
         random_state=config.seed,
         device=config.device,
         verbose=max(0, config.verbose - 1),  # 2: a line per class, 3: epoch progress
     )
+
+
+def _fit_estimator(method, train, test, config):
+    estimator = make_estimator(method, config)
     start = time.perf_counter()
     estimator.fit(train.X, train.y)
     fit_seconds = time.perf_counter() - start
@@ -137,7 +145,10 @@ def _fit_estimator(method, train, test, config):
         "predictions": predictions,
         "test_distances": distances,
         "classes": estimator.classes_,
-        "best_epochs": [getattr(a, "best_epoch", -1) for a in estimator.alignments_],
+        "best_epochs": [
+            a.best_epoch if isinstance(a, Alignment) else -1 for a in estimator.alignments_
+        ],
+        "iterations": [a.n_iter for a in estimator.alignments_],
         "output_length": [len(m) for m in estimator.means_],
     }
 
@@ -258,8 +269,7 @@ def warm_up(methods) -> None:
     X, y = rng.standard_normal((8, 20)).cumsum(1), [0] * 4 + [1] * 4
     for method in methods:
         if method in ESTIMATOR_METHODS and method not in _WARM:
-            estimator = RTWNearestCentroid(**ESTIMATOR_METHODS[method], n_epochs=2)
-            estimator.fit(X, y).predict(X)
+            make_estimator(method, RunConfig(epochs=2, verbose=0)).fit(X, y).predict(X)
             _WARM.add(method)
 
 

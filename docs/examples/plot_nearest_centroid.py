@@ -13,14 +13,14 @@ import numpy as np
 from aeon.datasets import load_classification
 from sklearn.metrics import ConfusionMatrixDisplay, accuracy_score
 
-from sk_rtw import RTWNearestCentroid
+from sk_rtw import RTW, RTWNearestCentroid
 from sk_rtw.utils import from_aeon
 
 X_train, y_train = load_classification("ItalyPowerDemand", split="train")
 X_test, y_test = load_classification("ItalyPowerDemand", split="test")
 X_train, X_test = from_aeon(X_train), from_aeon(X_test)  # (n, 1, T) -> (n, T)
 
-clf = RTWNearestCentroid(n_epochs=64, random_state=0).fit(X_train, y_train)
+clf = RTWNearestCentroid(method=RTW(n_epochs=64), random_state=0).fit(X_train, y_train)
 y_pred = clf.predict(X_test)
 print(f"test accuracy: {accuracy_score(y_test, y_pred):.3f} on {len(y_test)} days")
 

@@ -14,7 +14,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from sklearn.metrics import adjusted_rand_score
 
-from sk_rtw import RTWKMeans
+from sk_rtw import RTW, RTWKMeans
 from sk_rtw.datasets import make_warped_signals
 from sk_rtw.manifolds import Quaternion
 
@@ -30,7 +30,9 @@ X = X * np.where(rng.random(X.shape[:2]) < 0.3, -1.0, 1.0)[..., None]  # sign fl
 order = rng.permutation(len(X))
 X, motion = X[order], np.asarray(motion)[order]
 
-kmeans = RTWKMeans(n_clusters=3, manifold="quaternion", n_epochs=64, n_init=2, random_state=0)
+kmeans = RTWKMeans(
+    n_clusters=3, manifold="quaternion", method=RTW(n_epochs=64), n_init=2, random_state=0
+)
 kmeans.fit(X)
 print("adjusted Rand index against the motions:", adjusted_rand_score(motion, kmeans.labels_))
 print("inertia:", round(kmeans.inertia_, 3), "- iterations:", kmeans.n_iter_)

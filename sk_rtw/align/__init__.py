@@ -1,26 +1,23 @@
 """The alignment engine: Riemannian Time Warping and its TTW/NTW baselines."""
 
-from ._config import (
-    METHOD_DEFAULTS,
-    METHODS,
-    PRESETS,
-    AlignmentConfig,
-    classification_output_length,
-    default_output_length,
-    method_defaults,
-)
+from ._config import AlignmentConfig, knobs_markdown, presets_markdown
 from ._engine import Alignment, align
+from ._knobs import ENGINE_METHODS, KNOBS, METHODS, Knob
+from ._presets import PRESETS, OutputLength, Preset
 from ._sinc import tangent_sinc_interpolate
 
 __all__ = [
+    "ENGINE_METHODS",
+    "KNOBS",
     "METHODS",
-    "METHOD_DEFAULTS",
     "PRESETS",
     "Alignment",
     "AlignmentConfig",
+    "Knob",
+    "OutputLength",
+    "Preset",
     "align",
-    "classification_output_length",
-    "default_output_length",
-    "method_defaults",
+    "knobs_markdown",
+    "presets_markdown",
     "tangent_sinc_interpolate",
 ]

@@ -10,6 +10,7 @@ early stop).
 
 from __future__ import annotations
 
+import inspect
 import time
 from dataclasses import dataclass, field
 from typing import Any
@@ -21,12 +22,22 @@ from .._random import check_generator
 from .._resources import available_memory, format_bytes
 from .._threads import limited_threads, threads_for
 from ..manifolds import Manifold
+from ..manifolds._mean import frechet_mean
 from ..utils import SeriesCollection, check_series_collection
-from ._config import AlignmentConfig, resolve_config
+from ..utils._common_params import MANIFOLD, N_JOBS, RANDOM_STATE, VERBOSE
+from ..utils._params import AUTO, Declaration, Options, Parameter, Satisfies
+from ._config import (
+    DEVICE_PARAMETER,
+    PRESET_PARAMETER,
+    AlignmentConfig,
+    check_knobs,
+    check_preset,
+    resolve_config,
+)
 from ._density import density_representatives
+from ._knobs import ENGINE_METHODS, KNOBS
 from ._layout import GroupLayout
 from ._loss import window_weights
-from ._means import converged_group_mean, group_mean
 from ._sinc import TABLE_BYTES, SincInterpolator
 from ._start import dtw_start
 from ._training import Trainer, progress_printer
@@ -57,6 +68,8 @@ class Alignment:
         Seconds the fit took (for a batch of groups: the whole batch).
     n_iter : int
         Epochs run (fewer than ``config.n_epochs`` after an early stop).
+    cost : float
+        The loss (alignment loss + penalty) at the returned warps.
     """
 
     mean: np.ndarray
@@ -68,13 +81,16 @@ class Alignment:
     config: AlignmentConfig
     fit_time: float = field(default=0.0)
     n_iter: int = field(default=0)
+    cost: float = field(default=float("nan"))
 
 
 def _build_warps(
     config: AlignmentConfig, layout: GroupLayout, seeds: list[int]
 ) -> NeuralWarps | SineWarps:
     if config.warp == "sine":
+        assert config.n_components is not None  # resolved for TTW
         return SineWarps(layout, config.n_components)
+    assert config.hidden_size is not None and config.init is not None  # resolved for RTW, NTW
     return NeuralWarps(layout, config.hidden_size, config.init, config.warp_knots, seeds)
 
 
@@ -118,15 +134,18 @@ class _Problem:
         """The engine's mean of every group's aligned series (loss and returned mean)."""
         config = self.config
         points, weights = self.points_and_weights(warps, aligned)
+        codes, sizes = self.layout.codes, self.layout.sizes
         if self.manifold.is_flat:  # exact in one step, from any start
-            return group_mean(self.manifold, points, self.layout, weights)
+            return frechet_mean(self.manifold, points, weights, codes, sizes=sizes)
         if config.mean_start == "first":
-            return group_mean(self.manifold, points, self.layout, weights,
-                              iterations=config.mean_iterations, differentiate="all")  # fmt: skip
+            return frechet_mean(self.manifold, points, weights, codes, sizes=sizes,
+                                max_iter=config.mean_iterations, tol=0.0)  # fmt: skip
         if self.warm is None or self.warm.shape[1] != points.shape[1]:
-            return converged_group_mean(self.manifold, points, self.layout, weights)
-        mean = group_mean(self.manifold, points, self.layout, weights, start=self.warm,
-                          iterations=config.mean_iterations, differentiate="last")  # fmt: skip
+            return frechet_mean(self.manifold, points, weights, codes, sizes=sizes,
+                                differentiate="none")  # fmt: skip
+        mean = frechet_mean(self.manifold, points, weights, codes, sizes=sizes, start=self.warm,
+                            max_iter=config.mean_iterations, tol=0.0,
+                            differentiate="last")  # fmt: skip
         self.warm.copy_(mean.detach())
         return mean
 
@@ -135,8 +154,9 @@ class _Problem:
         with torch.no_grad():
             aligned = self.interpolate(warps)
             points, weights = self.points_and_weights(warps, aligned)
-            return converged_group_mean(self.manifold, points, self.layout, weights,
-                                        start=start)  # fmt: skip
+            return frechet_mean(self.manifold, points, weights, self.layout.codes,
+                                start=start, differentiate="none",
+                                sizes=self.layout.sizes)  # fmt: skip
 
     def initial_warps(self) -> torch.Tensor:
         identity = self.zhat.expand(self.layout.n_series, -1)
@@ -163,27 +183,42 @@ class _Problem:
         return group_loss.sum(), group_loss, warps, aligned, mean
 
 
+def _is_engine_method(value: Any) -> bool:
+    return callable(getattr(value, "settings", None)) and getattr(value, "name", None) in (
+        ENGINE_METHODS
+    )
+
+
+ALIGN_VERBOSE = Parameter(
+    "verbose",
+    VERBOSE.constraints,
+    "Print the loss every max(1, n_epochs // 10) epochs (True or 1), or every verbose "
+    "epochs (an int > 1).",
+)
+ALIGN_METHOD = Parameter(
+    "method",
+    (
+        Options(ENGINE_METHODS),
+        Satisfies(_is_engine_method, "RTW, TTW or NTW", "RTW(), TTW() or NTW()"),
+    ),
+    'The method: "rtw" (neural warps, windowed sinc, Gaussian window loss, monotonicity '
+    'penalty), "ntw" (neural warps with zero init, full sinc, pointwise loss) or "ttw" '
+    "(sine-series warps with running-maximum monotonicity, windowed sinc, pointwise loss); "
+    "or a method object holding settings, RTW(hidden_size=64).",
+)
+
+
 def align(
     X: Any,
     *,
     manifold: str | Manifold = "euclidean",
-    method: str = "rtw",
-    preset: str | None = None,
-    output_length: int | None = None,
-    n_epochs: int = 256,
-    learning_rate: float = 0.01,
-    sinc_window: int | str | None = None,
-    loss_window: int | None = None,
-    loss_step: int | None = None,
-    penalty: float | None = None,
-    warp_start: str | Any = "auto",
-    n_iter_no_change: int | str | None = "auto",
-    tol: float | None = None,
+    method: Any = "rtw",
+    preset: str = "alignment",
     random_state: Any = None,
     device: str | torch.device = "cpu",
     n_jobs: int | None = None,
     verbose: bool | int = False,
-    **method_options: Any,
+    **settings: Any,
 ) -> Alignment:
     """Jointly align N time series on a Riemannian manifold and compute their mean.
 
@@ -192,98 +227,27 @@ def align(
     Riemannian Time Warping (``"rtw"``) or the Riemannian forms of its baselines
     Trainable Time Warping (``"ttw"``) and Neural Time Warping (``"ntw"``); all three run
     through the same interpolation, mean, loss and optimisation code. ``preset="paper"``
-    gives the paper's exact configuration of each method.
+    gives the paper's exact configuration of each method; every other setting (the
+    knobs below) defaults to ``"auto"``, the preset's value, resolved as in the
+    estimators: the same preset gives the same configuration for the same series.
 
     Parameters
     ----------
     X : array-like or list of array-like
         ``(N, T)`` univariate, ``(N, T, *point_shape)`` or a list of ``(T_n, *point_shape)``
         series of unequal lengths (each is interpolated with its own ``T_n``).
-    manifold : str or Manifold, default="euclidean"
-        Space of the samples; a name takes its dimension from the data.
-    method : {"rtw", "ttw", "ntw"}, default="rtw"
-        Warp model, loss and interpolation defaults:
-
-        - ``"rtw"``: neural warps, windowed sinc, Gaussian window loss, monotonicity
-          penalty;
-        - ``"ntw"``: neural warps (zero init), full sinc, pointwise loss, penalty;
-        - ``"ttw"``: sine-series warps with running-maximum monotonicity, windowed sinc,
-          pointwise loss.
-    preset : {"alignment", "class-means", "paper", "default"} or None, default=None
-        None or ``"default"``: ``"alignment"``, ``Z = min(N, 4) T_max``, a warp network of
-        width 512 on 64 knots, no tangent-point refinement, the mean warm-started from the
-        previous epoch, early stopping, and for RTW the DTW start (``warp_start="dtw"``)
-        on the average time axis with a zero-readout network and the paper's equal-weight
-        mean. ``"class-means"`` (the estimators' default): width 64, a quicker stop, and
-        for RTW the density-weighted mean on the reference's time axis (see
-        ``mean_weights`` below). ``"paper"``: the paper's configuration (``Z = N T_max``,
-        warps starting at the identity, Xavier-initialised network evaluated at every
-        output time, interpolation tangent point refined twice, all epochs). Explicit
-        arguments override the preset.
-    output_length : int, optional
-        Length ``Z`` of the aligned series and mean (preset default: ``min(N, 4) T_max``,
-        or ``N T_max`` for the paper).
-    n_epochs : int, default=256
-        Adam iterations; the parameters of the epoch with the lowest loss are kept.
-    learning_rate : float, default=0.01
-        Adam learning rate.
-    sinc_window : int or "full", optional
-        Half-width ``nu`` of the sinc window (method default: 10; ``"full"`` for NTW).
-    loss_window, loss_step : int, optional
-        ``kappa`` and ``rho`` of the Gaussian-weighted window loss (RTW: 5 and 5;
-        TTW/NTW: 0, the pointwise loss).
-    penalty : float, optional
-        Weight ``lambda`` of the monotonicity penalty (RTW/NTW: 100; TTW: 0).
-    warp_start : {"identity", "dtw"} or array-like of shape (N, Z), optional
-        What the learned warps start from. ``"identity"``: the paper. ``"dtw"``: warps
-        read off DTW paths to a reference series (the medoid, then the mean, for
-        ``dtw_rounds`` rounds), centred so that their average is the identity; the
-        learned warps are composed with them. An array: your own non-decreasing warps,
-        from 0 to 1, at the ``Z`` output times. Default: the preset's (RTW: ``"dtw"``;
-        TTW, NTW and the paper preset: ``"identity"``).
-    n_iter_no_change : int, None or "auto", default="auto"
-        Stop when the loss has not improved by more than ``tol`` (relative) for this many
-        epochs in a row, keeping the best iterate; None trains all ``n_epochs``.
-        ``"auto"``: the preset's (20; the paper preset: None).
-    tol : float, optional
-        Relative improvement that counts for ``n_iter_no_change`` (default 1e-4).
-    random_state : int, RandomState, Generator or None
-        Seeds the network initialisation and the DTW start; equal seeds give identical
-        results.
-    device : str or torch.device, default="cpu"
-        Torch device for the optimisation, e.g. ``"cuda"``. Results are numpy arrays.
-    n_jobs : int, optional
-        Threads of torch and numba during the fit, scikit-learn's convention (None: 1,
-        -1: all cores); more than one only where the problem is large enough to gain from
-        them. The caller's thread settings are restored afterwards.
-    verbose : bool or int, default=False
-        Print the loss every ``max(1, n_epochs // 10)`` epochs (or every ``verbose``
-        epochs when an int > 1).
-    **method_options
-        ``n_components`` (TTW sine terms, default 8), ``hidden_size`` (width of the warp
-        network, 512; 64 in ``"class-means"``), ``warp_knots`` (times at which the warp
-        network is evaluated and linearly interpolated between; None evaluates it at
-        every output time as the paper does), ``tangent_refinements`` (Gauss–Newton
-        refinements of the sinc tangent point; 0 uses the centre sample of the window,
-        whose tangent vectors are then computed once per fit), ``mean_iterations``
-        (Gauss–Newton steps of the mean per epoch, 2; the paper's 5), ``mean_start``
-        (``"previous"``: from the previous epoch's mean, only the last step
-        differentiated; ``"first"``: the paper's steps from the first series, all
-        differentiated), ``mean_weights`` (``"equal"``: the paper's mean of the aligned
-        series; ``"density"``: every series weighted by the samples each output time
-        covers, see :mod:`sk_rtw.align._density`), ``init`` (``"xavier"``, ``"zeros"`` or
-        ``"zero-readout"``), ``dtw_rounds`` (references of the DTW start, 3), ``smoothing``
-        (Gaussian smoothing of the DTW path warps, in reference samples, 2.0),
-        ``start_axis`` (``"average"`` or ``"reference"``: the time axis of the DTW start),
-        ``cuda_graph`` (capture each epoch in a CUDA graph on a CUDA device; off by
-        default, see the GPU guide).
+    %(parameters)s
+    **settings
+        The knobs of the method (all ``"auto"`` by default): %(knobs)s. ``warp_start``
+        also takes your own starting warps, an array of shape (N, Z), non-decreasing
+        from 0 to 1. A knob of another method is a ``TypeError`` naming it.
 
     Returns
     -------
     Alignment
         ``mean`` (Z, *point_shape), ``aligned`` (N, Z, *point_shape), ``warps`` (N, Z),
-        ``loss_history``, ``best_epoch``, ``n_iter``, ``manifold`` and the resolved
-        ``config``.
+        ``loss_history``, ``best_epoch``, ``n_iter``, ``cost``, ``manifold`` and the
+        resolved ``config``.
 
     Examples
     --------
@@ -297,36 +261,67 @@ def align(
     >>> align(X, preset="paper", n_epochs=2).mean.shape  # Z = N T_max
     (150, 1)
     """
+    method = ALIGN_METHOD.check(method)
+    if not isinstance(method, str):  # a method object: its settings, then the keywords
+        settings = {**method.settings(), **settings}
+        method = method.name
+    preset = check_preset(preset)
+    device_name = DEVICE_PARAMETER.check(device)
+    RANDOM_STATE.check(random_state)
+    N_JOBS.check(n_jobs)
+    ALIGN_VERBOSE.check(verbose)
+    given = settings.get("warp_start")
+    given_start = None
+    if given is not None and not isinstance(given, str):
+        settings = {k: v for k, v in settings.items() if k != "warp_start"}
+    explicit = check_knobs(method, settings)
     collection = X if isinstance(X, SeriesCollection) else check_series_collection(X, manifold)
     n_signals = collection.n_series
-    given_start = None
-    if not isinstance(warp_start, str):
-        given_start = _check_warps(warp_start, n_signals, output_length)
-        output_length = given_start.shape[1]
-    config = resolve_config(
-        method,
-        n_signals,
-        collection.max_length,
-        preset=preset,
-        output_length=output_length,
-        n_epochs=n_epochs,
-        learning_rate=learning_rate,
-        sinc_window=sinc_window,
-        loss_window=loss_window,
-        loss_step=loss_step,
-        penalty=penalty,
-        device=device,
-        warp_start="given" if given_start is not None else warp_start,
-        n_iter_no_change=n_iter_no_change,
-        tol=tol,
-        method_options=method_options,
-    )
+    if given is not None and not isinstance(given, str):
+        given_start = _check_warps(given, n_signals, explicit.get("output_length"))
+        explicit["output_length"] = given_start.shape[1]
+    config = resolve_config(method, preset, explicit, collection.lengths, device=device_name,
+                            given_start=given_start is not None)  # fmt: skip
     seed = int(check_generator(random_state).integers(2**31 - 1))
     (result,) = align_collection(
         collection, np.zeros(n_signals, dtype=np.int64), [seed], config,
         given_start=given_start, n_jobs=n_jobs, verbose=verbose,
     )  # fmt: skip
     return result
+
+
+def _align_docs() -> None:
+    """``align``'s signature and "Parameters" from the declarations (knobs included)."""
+    own = Declaration(
+        (MANIFOLD, ALIGN_METHOD, PRESET_PARAMETER, RANDOM_STATE, DEVICE_PARAMETER, N_JOBS,
+         ALIGN_VERBOSE),
+        {"manifold": "euclidean", "method": "rtw", "preset": "alignment", "random_state": None,
+         "device": "cpu", "n_jobs": None, "verbose": False},
+    )  # fmt: skip
+    knobs = [KNOBS[name] for name in KNOBS if set(KNOBS[name].methods) & set(ENGINE_METHODS)]
+    listing = ", ".join(f"``{k.name}``" for k in knobs)
+    doc = align.__doc__ or ""
+    indent = "    "
+    block = "\n".join(indent + line if line else line for line in own.docs().splitlines())
+    align.__doc__ = doc.replace("    %(parameters)s", block).replace("%(knobs)s", listing)
+    parameters = [inspect.Parameter("X", inspect.Parameter.POSITIONAL_OR_KEYWORD)]
+    parameters += [
+        inspect.Parameter(p.name, inspect.Parameter.KEYWORD_ONLY, default=own.defaults[p.name])
+        for p in own.parameters[:3]
+    ]
+    parameters += [
+        inspect.Parameter(k.name, inspect.Parameter.KEYWORD_ONLY, default=AUTO) for k in knobs
+    ]
+    parameters += [
+        inspect.Parameter(p.name, inspect.Parameter.KEYWORD_ONLY, default=own.defaults[p.name])
+        for p in own.parameters[3:]
+    ]
+    align.__signature__ = inspect.Signature(  # type: ignore[attr-defined]
+        parameters, return_annotation="Alignment"
+    )
+
+
+_align_docs()
 
 
 def align_collection(
@@ -408,8 +403,9 @@ def align_collection(
         if layout.max_size > 1 and config.n_epochs > 0 and trainable:
             best_epoch, epochs_run = _optimise(problem, model, history, verbose)
         with torch.no_grad():
-            _, _, warps, aligned, mean = problem.forward(model)
+            _, group_loss, warps, aligned, mean = problem.forward(model)
             mean = problem.converged_mean(warps, start=mean)
+            costs = group_loss.cpu().numpy()
     factor = 1.0 if scale is None else scale
     manifold = collection.manifold
     fit_time = time.perf_counter() - start_time
@@ -428,6 +424,7 @@ def align_collection(
                 config=config,
                 fit_time=fit_time,
                 n_iter=int(epochs_run[g]),
+                cost=float(costs[g]),
             )
         )
     return results
@@ -449,7 +446,8 @@ def estimated_memory(collection: SeriesCollection, config: AlignmentConfig) -> i
     taps = t_max if config.sinc_window is None else 2 * config.sinc_window + 1
     table = min(8 * n_series * t_max * taps * point, TABLE_BYTES)
     times = z if config.warp_knots is None else min(z, config.warp_knots)
-    network = 8 * 3 * times * (2 * config.hidden_size + 1 + n_series) + 8 * 4 * z * n_series
+    width = config.hidden_size or 0  # TTW's sine warps have no network
+    network = 8 * 3 * times * (2 * width + 1 + n_series) + 8 * 4 * z * n_series
     return n_series * z * per_point + table + network
 
 

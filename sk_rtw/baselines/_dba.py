@@ -6,14 +6,19 @@ import sys
 from typing import Any
 
 import numpy as np
+import torch
 
 from ..dtw import check_window, medoid_index, path_indices
 from ..manifolds import Manifold
+from ..manifolds._mean import frechet_mean
 from ..utils import check_series_collection
-from ._result import MultipleAlignment, grouped_mean, make_result
+from ..utils._params import Interval, Parameter
+from ._result import MultipleAlignment, make_result
 
 #: Gauss–Newton steps of each per-sample Fréchet mean in one DBA iteration.
 MEAN_STEPS = 8
+MAX_ITER = Parameter("max_iter", (Interval(int, 1),), "Most refinement iterations.")
+TOL = Parameter("tol", (Interval(float, 0.0),), "Relative cost improvement that counts.")
 
 
 def _initial_mean(collection, init, window, squared) -> np.ndarray:
@@ -29,7 +34,7 @@ def dba_average(
     X: Any,
     manifold: str | Manifold = "euclidean",
     *,
-    n_iter: int = 10,
+    max_iter: int = 10,
     init: str | Any = "medoid",
     window: float | None = None,
     squared: bool = True,
@@ -49,8 +54,8 @@ def dba_average(
         Input series.
     manifold : str or Manifold, default="euclidean"
         Space of the samples.
-    n_iter : int, default=10
-        Maximum number of refinement iterations.
+    max_iter : int, default=10
+        Most refinement iterations.
     init : "medoid" or array-like of shape (L, *point_shape), default="medoid"
         Starting average: the series with the smallest summed DTW to the others, or the
         given series.
@@ -68,10 +73,9 @@ def dba_average(
     MultipleAlignment
         ``mean`` of shape ``(L, *point_shape)``; ``indices[n, l]`` is the first sample of
         series ``n`` matched with ``mean[l]``; ``cost`` is the summed DTW cost of the
-        series to the returned mean.
+        series to the returned mean; ``n_iter`` the refinement iterations run.
     """
-    if isinstance(n_iter, bool) or not isinstance(n_iter, (int, np.integer)) or n_iter < 1:
-        raise ValueError(f"n_iter must be a positive integer, got {n_iter!r}")
+    max_iter, tol = MAX_ITER.check(max_iter), TOL.check(tol)
     collection = check_series_collection(X, manifold, name="X", min_length=1)
     M = collection.manifold
     w = check_window(window)
@@ -79,22 +83,33 @@ def dba_average(
     mean = _initial_mean(collection, init, window, squared)
     best: tuple[float, np.ndarray, tuple[np.ndarray, ...]] | None = None
     previous = np.inf
-    for iteration in range(n_iter + 1):
+    iteration = 0
+    for iteration in range(max_iter + 1):
         paths, costs = zip(*(path_indices(mean, s, M, w, squared) for s in series), strict=True)
         cost = float(sum(costs))
         if best is None or cost < best[0]:
             best = (cost, mean, paths)
         if verbose:
             print(f"DBA iteration {iteration}: cost {cost:.6g}", file=sys.stderr)
-        if iteration == n_iter or (iteration > 0 and previous - cost <= tol * previous):
+        if iteration == max_iter or (iteration > 0 and previous - cost <= tol * previous):
             break
         previous = cost
-        groups = np.concatenate([p[:, 0] for p in paths])
-        points = np.concatenate([s[p[:, 1]] for s, p in zip(series, paths, strict=True)])
-        # Gauss–Newton from the previous average: it is close, so a few steps suffice.
-        mean = grouped_mean(M, groups, points, len(mean), start=mean, max_iter=MEAN_STEPS, tol=0.0)
+        mean = _matched_means(M, series, paths, mean)
     assert best is not None  # the loop runs at least once
     cost, mean, paths = best
     first = [np.searchsorted(p[:, 0], np.arange(len(mean))) for p in paths]
     indices = np.stack([p[f, 1] for p, f in zip(paths, first, strict=True)])
-    return make_result(series, indices, mean, cost, M)
+    return make_result(series, indices, mean, cost, M, n_iter=iteration)
+
+
+def _matched_means(manifold: Manifold, series, paths, mean: np.ndarray) -> np.ndarray:
+    """Every sample of the average replaced by the Fréchet mean of the points matched to
+    it, by Gauss–Newton steps from the previous average (it is close: a few suffice)."""
+    codes = np.concatenate([p[:, 0] for p in paths])
+    points = np.concatenate([s[p[:, 1]] for s, p in zip(series, paths, strict=True)])
+    with torch.no_grad():
+        new = frechet_mean(
+            manifold, torch.as_tensor(points), codes=torch.as_tensor(codes),
+            start=torch.as_tensor(mean), max_iter=MEAN_STEPS, tol=0.0, differentiate="none",
+        )  # fmt: skip
+    return new.numpy()

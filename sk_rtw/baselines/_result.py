@@ -3,9 +3,9 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
-import torch
 
 from ..manifolds import Manifold
 
@@ -29,6 +29,12 @@ class MultipleAlignment:
     cost : float
         The objective the method minimised (its definition is given by each method).
     manifold : Manifold
+    n_iter : int
+        Refinement iterations run (DBA); 0 for the one-pass methods.
+    config : object or None
+        The resolved settings, when the result comes from an estimator's method object.
+    fit_time : float
+        Seconds the fit took, when measured by an estimator's method object.
     """
 
     mean: np.ndarray
@@ -37,10 +43,18 @@ class MultipleAlignment:
     warps: np.ndarray
     cost: float
     manifold: Manifold
+    n_iter: int = 0
+    config: Any = None
+    fit_time: float = 0.0
 
 
 def make_result(
-    series: list[np.ndarray], indices: np.ndarray, mean: np.ndarray, cost: float, manifold
+    series: list[np.ndarray],
+    indices: np.ndarray,
+    mean: np.ndarray,
+    cost: float,
+    manifold,
+    n_iter: int = 0,
 ) -> MultipleAlignment:
     """Assemble a :class:`MultipleAlignment` from per-series index arrays ``(N, L)``."""
     indices = np.asarray(indices, dtype=np.int64)
@@ -53,41 +67,5 @@ def make_result(
         warps=indices / scale,
         cost=float(cost),
         manifold=manifold,
+        n_iter=int(n_iter),
     )
-
-
-def grouped_mean(
-    manifold: Manifold,
-    groups: np.ndarray,
-    points: np.ndarray,
-    n_groups: int,
-    start: np.ndarray | None = None,
-    max_iter: int = 64,
-    tol: float = 1e-10,
-) -> np.ndarray:
-    """Fréchet mean of ``points`` per group label in ``range(n_groups)``, all at once.
-
-    Groups of different sizes are padded to the largest one with zero-weight copies of
-    their first point, so one batched Gauss–Newton run averages every group. ``start``
-    ``(n_groups, *point_shape)`` puts a starting estimate first in every group (weight 0).
-    """
-    order = np.argsort(groups, kind="stable")
-    groups, points = groups[order], points[order]
-    counts = np.bincount(groups, minlength=n_groups)
-    if np.any(counts == 0):
-        raise ValueError("every group needs at least one point")
-    starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
-    slots = np.arange(len(groups)) - starts[groups]
-    offset = 0 if start is None else 1
-    padded = np.repeat(points[starts][:, None], counts.max() + offset, axis=1)
-    if start is not None:
-        padded[:, 0] = start
-    padded[groups, slots + offset] = points
-    weights = np.zeros((n_groups, counts.max() + offset))
-    weights[groups, slots + offset] = 1.0
-    # torch in, torch out: the points were validated on the way in; a fixed number of
-    # steps from a close start is what DBA asks for (tol=0: no convergence warning)
-    mean = manifold.mean(
-        torch.as_tensor(padded), torch.as_tensor(weights.T), axis=1, max_iter=max_iter, tol=tol
-    )
-    return mean.numpy()

@@ -10,15 +10,15 @@ from sklearn.utils import check_random_state, column_or_1d
 from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted
 
-from .._numba import check_n_jobs
-from .._random import check_random_state_value
-from ..align._config import check_preset
-from ..dtw import check_window, dtw_pairwise_distance
-from ..manifolds import Manifold
+from ..dtw import dtw_pairwise_distance
+from ..methods import FitContext, get_method
 from ..utils import check_series_collection
-from ._core import ESTIMATOR_METHODS, centre_settings, engine_keywords, fit_centres, kmeans
+from ..utils._params import declare_parameters, validate_parameters
+from ._core import fit_centroids, kmeans
+from ._params import AVERAGER_DEFAULTS, AVERAGER_PARAMETERS, setting_hint
 
 
+@declare_parameters(AVERAGER_PARAMETERS, AVERAGER_DEFAULTS, hint=setting_hint)
 class RTWAverager(TransformerMixin, BaseEstimator):
     """Learn one Riemannian Time Warping mean per class (or several); transform to DTW
     distances.
@@ -31,72 +31,15 @@ class RTWAverager(TransformerMixin, BaseEstimator):
     centroids by k-means with the same averaging, and ``transform`` returns the distance
     to every centroid: features for a downstream classifier.
 
+    What to set: ``manifold`` for your data; ``method`` and ``preset`` choose the
+    averaging (the default, density-weighted RTW means of the median class length, is
+    what classifies best on the UCR development archive; ``preset="paper"`` is the
+    paper's configuration); the method's own settings go in its object,
+    ``method=RTW(n_epochs=64)``.
+
     Parameters
     ----------
-    manifold : str or Manifold, default="euclidean"
-        Space of the samples; a name takes its dimension from the data.
-    method : {"rtw", "ttw", "ntw", "dba"} or None, default=None
-        Averaging method; None is the estimator's own (RTW here; TTW for
-        :class:`TTWAverager`, ...). ``"dba"``: DTW barycenter averaging with Fréchet means
-        (:func:`sk_rtw.baselines.dba_average`, squared costs, medoid start), on any
-        manifold. Searchable with ``GridSearchCV`` like any parameter.
-    preset : {"class-means", "alignment", "paper", "default"} or None, default=None
-        Engine preset (see :func:`sk_rtw.align`). None or ``"default"``:
-        ``"class-means"``, density-weighted RTW means on the time axis of the DTW
-        reference (what classifies best on the UCR development archive);
-        ``"alignment"``: :func:`sk_rtw.align`'s defaults; ``"paper"``: the paper's exact
-        configuration (means of length ``N T_max``, warps starting at the identity).
-    output_length : int, optional
-        Length ``Z`` of the means. Default: the median length of each class's training
-        series (:func:`sk_rtw.align.classification_output_length`): means longer than
-        the series they are compared with classify worse; the paper preset uses ``N
-        T_max`` per class. Not used by DBA, whose means keep the length of their start
-        (the class medoid).
-    n_epochs : int, default=256
-        Most Adam epochs per class.
-    learning_rate : float, default=0.01
-    sinc_window, loss_window, loss_step, penalty : optional
-        Engine settings; None takes the method's default (see :func:`sk_rtw.align`).
-    warp_start : {"auto", "identity", "dtw"}, default="auto"
-        Starting warps (``"auto"``: the preset's; RTW starts from DTW paths by default).
-    n_components : int, default=8
-        Sine terms of the TTW warps (TTW only).
-    hidden_size : int or "auto", default="auto"
-        Hidden width of the RTW/NTW warp network (``"auto"``: the preset's, 64; the paper's
-        512 with ``preset="paper"``).
-    warp_knots : int, None or "auto", default="auto"
-        Times at which the warp network is evaluated (linear in between); None: at every
-        output time (the paper); ``"auto"``: the preset's (64, or None for the paper).
-    tangent_refinements : int or "auto", default="auto"
-        Gauss–Newton refinements of the interpolation tangent point (``"auto"``: the
-        preset's, 0 or 2 for the paper).
-    mean_iterations : int or "auto", default="auto"
-        Gauss–Newton iterations of the mean per epoch (``"auto"``: the preset's).
-    mean_weights : {"auto", "density", "equal"}, default="auto"
-        How the aligned series enter the class mean: ``"density"`` weighs every series by
-        the samples each output time covers (DBA's counting, for continuous warps; the
-        RTW default of the ``"class-means"`` preset), ``"equal"`` is the paper's mean.
-        Searchable with ``GridSearchCV``.
-    n_iter_no_change : int, None or "auto", default="auto"
-        Stop a class's training after this many epochs without a relative improvement of
-        ``tol`` (None: all ``n_epochs``; ``"auto"``: the preset's).
-    tol : float, optional
-        Relative improvement that counts for ``n_iter_no_change`` (the preset's: 1e-3).
-    n_centroids : int, default=1
-        Centroids per class. Above 1, each class is clustered by k-means (the estimator's
-        averaging method, k-means++ seeding, at most 10 rounds; at most one centroid per
-        series), and ``means_`` holds every centroid.
-    dtw_window : float in [0, 1], optional
-        Sakoe–Chiba band of the DTW used by ``transform`` (and by DBA).
-    n_jobs : int, optional
-        Threads of the fit (scikit-learn's convention, None: 1) and of the DTW
-        computations; DBA fits classes in parallel with joblib.
-    random_state : int, RandomState or None
-        Seeds the warp initialisation of every class.
-    device : str, default="cpu"
-        Torch device of the optimisation (e.g. ``"cuda"``); fitted attributes are numpy.
-    verbose : int, default=0
-        1: one line per class; 2: also the loss during training.
+    %(parameters)s
 
     Attributes
     ----------
@@ -108,8 +51,8 @@ class RTWAverager(TransformerMixin, BaseEstimator):
     centroid_classes_ : ndarray of shape (n_means,)
         Class index (into ``classes_``) of every entry of ``means_``.
     alignments_ : list of Alignment or MultipleAlignment
-        Per entry of ``means_``: aligned series, warps and, for the engine's methods, loss
-        history and configuration.
+        Per entry of ``means_``: the method's result (mean, aligned series, warps, cost,
+        iterations run, resolved ``config``; see :class:`sk_rtw.methods.AveragingResult`).
     assignments_ : ndarray of shape (n_series,)
         Entry of ``means_`` that every training series was averaged into.
     method_ : str
@@ -123,71 +66,15 @@ class RTWAverager(TransformerMixin, BaseEstimator):
     Examples
     --------
     >>> import numpy as np
-    >>> from sk_rtw import RTWAverager
+    >>> from sk_rtw import RTW, RTWAverager
     >>> t = np.linspace(0, 1, 40)
     >>> X = np.stack([np.sin(2 * np.pi * t ** p) for p in (0.8, 1.0, 1.2, 0.9)])
-    >>> averager = RTWAverager(n_epochs=10, random_state=0).fit(X, [0, 0, 1, 1])
+    >>> averager = RTWAverager(method=RTW(n_epochs=10), random_state=0).fit(X, [0, 0, 1, 1])
     >>> averager.means_.shape, averager.transform(X).shape
     ((2, 40, 1), (4, 2))
     >>> RTWAverager(method="dba").fit(X, [0, 0, 1, 1]).means_.shape
     (2, 40, 1)
     """
-
-    _method = "rtw"
-
-    def __init__(
-        self,
-        manifold: str | Manifold = "euclidean",
-        method: str | None = None,
-        preset: str | None = None,
-        output_length: int | None = None,
-        n_epochs: int = 256,
-        learning_rate: float = 0.01,
-        sinc_window: int | str | None = None,
-        loss_window: int | None = None,
-        loss_step: int | None = None,
-        penalty: float | None = None,
-        warp_start: str = "auto",
-        n_components: int = 8,
-        hidden_size: int | str = "auto",
-        warp_knots: int | str | None = "auto",
-        tangent_refinements: int | str = "auto",
-        mean_iterations: int | str = "auto",
-        mean_weights: str = "auto",
-        n_iter_no_change: int | str | None = "auto",
-        tol: float | None = None,
-        n_centroids: int = 1,
-        dtw_window: float | None = None,
-        n_jobs: int | None = None,
-        random_state: Any = None,
-        device: str = "cpu",
-        verbose: int = 0,
-    ):
-        self.manifold = manifold
-        self.method = method
-        self.preset = preset
-        self.output_length = output_length
-        self.n_epochs = n_epochs
-        self.learning_rate = learning_rate
-        self.sinc_window = sinc_window
-        self.loss_window = loss_window
-        self.loss_step = loss_step
-        self.penalty = penalty
-        self.warp_start = warp_start
-        self.n_components = n_components
-        self.hidden_size = hidden_size
-        self.warp_knots = warp_knots
-        self.tangent_refinements = tangent_refinements
-        self.mean_iterations = mean_iterations
-        self.mean_weights = mean_weights
-        self.n_iter_no_change = n_iter_no_change
-        self.tol = tol
-        self.n_centroids = n_centroids
-        self.dtw_window = dtw_window
-        self.n_jobs = n_jobs
-        self.random_state = random_state
-        self.device = device
-        self.verbose = verbose
 
     # ------------------------------------------------------------------ fit
     def fit(self, X: Any, y: Any = None):
@@ -207,28 +94,15 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         self._fit_means(X, y, require_two_classes=False)
         return self
 
-    def _resolve_method(self) -> str:
-        method = self._method if self.method is None else self.method
-        if not isinstance(method, str) or method.lower() not in ESTIMATOR_METHODS:
-            raise ValueError(
-                f"method must be one of {ESTIMATOR_METHODS} or None, got {self.method!r}"
-            )
-        return method.lower()
-
-    def _check_n_centroids(self) -> int:
-        k = self.n_centroids
-        if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
-            raise ValueError(f"n_centroids must be an integer >= 1, got {k!r}")
-        return int(k)
-
     def _fit_means(self, X, y, require_two_classes):
-        """Validate, then fit ``n_centroids`` means per class (k-means above 1)."""
-        method = self._resolve_method()
-        n_centroids = self._check_n_centroids()
-        check_preset(self.preset)
-        check_random_state_value(self.random_state)
-        check_n_jobs(self.n_jobs)
-        check_window(self.dtw_window, name="dtw_window")  # in fit, not only at predict
+        """Validate every parameter, then fit ``n_centroids`` means per class."""
+        params = validate_parameters(self)
+        method = get_method(params["method"])
+        method.settings()  # every setting of the method checked before any work
+        context = FitContext(
+            preset=params["preset"], dtw_window=params["dtw_window"], device=params["device"],
+            n_jobs=params["n_jobs"], verbose=int(params["verbose"]),
+        )  # fmt: skip
         collection = check_series_collection(X, self.manifold)
         if y is None:
             labels = np.zeros(collection.n_series, dtype=int)
@@ -241,22 +115,18 @@ class RTWAverager(TransformerMixin, BaseEstimator):
                 f"class ({classes.tolist()})"
             )
         sizes = np.bincount(codes)
-        settings = centre_settings(
-            method,
-            engine=engine_keywords(self.get_params(), output_length=self.output_length),
-            dtw_window=self.dtw_window, n_jobs=self.n_jobs, verbose=self.verbose,
-            owner=type(self).__name__,
-        )  # fmt: skip
         seeds = check_random_state(self.random_state).randint(2**31 - 1, size=len(classes))
+        owner = type(self).__name__
+        n_centroids = params["n_centroids"]
         if n_centroids == 1:
-            fits = fit_centres(collection, codes, [int(s) for s in seeds], settings,
-                              list(classes), kind="class")  # fmt: skip
+            fits = fit_centroids(method, collection, codes, [int(s) for s in seeds], context,
+                                 names=list(classes), kind="class", owner=owner)  # fmt: skip
             centroid_classes = np.arange(len(classes))
             assignments = codes
         else:
             rngs = [np.random.RandomState(int(s)) for s in seeds]
             clusterings = kmeans(collection, codes, [min(n_centroids, int(n)) for n in sizes],
-                                 settings, rngs)  # fmt: skip
+                                 method, context, rngs, owner=owner)  # fmt: skip
             fits = [fit for clustering in clusterings for fit in clustering.fits]
             counts = [len(clustering.fits) for clustering in clusterings]
             centroid_classes = np.repeat(np.arange(len(classes)), counts)
@@ -265,7 +135,7 @@ class RTWAverager(TransformerMixin, BaseEstimator):
             for c, clustering in enumerate(clusterings):
                 assignments[codes == c] = offsets[c] + clustering.labels
         self.classes_ = classes
-        self.method_ = method
+        self.method_ = method.name
         self.manifold_ = collection.manifold
         self.alignments_ = fits
         self.centroid_classes_ = centroid_classes
@@ -305,26 +175,30 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         return tags
 
 
+@declare_parameters(defaults={"method": "ttw"})
 class TTWAverager(RTWAverager):
     """Class means by Riemannian Trainable Time Warping (sine-series warps).
 
-    Same parameters, attributes and input shapes (``(n_series, n_timepoints[,
-    *point_shape])`` or a list of series) as :class:`RTWAverager`; engine defaults of
-    ``"ttw"``.
+    :class:`RTWAverager` with ``method="ttw"``: the same attributes and input shapes
+    (``(n_series, n_timepoints[, *point_shape])`` or a list of series).
+
+    Parameters
+    ----------
+    %(parameters)s
     """
 
-    _method = "ttw"
 
-
+@declare_parameters(defaults={"method": "ntw"})
 class NTWAverager(RTWAverager):
     """Class means by Riemannian Neural Time Warping (zero-initialised network, full sinc).
 
-    Same parameters, attributes and input shapes (``(n_series, n_timepoints[,
-    *point_shape])`` or a list of series) as :class:`RTWAverager`; engine defaults of
-    ``"ntw"``.
-    """
+    :class:`RTWAverager` with ``method="ntw"``: the same attributes and input shapes
+    (``(n_series, n_timepoints[, *point_shape])`` or a list of series).
 
-    _method = "ntw"
+    Parameters
+    ----------
+    %(parameters)s
+    """
 
 
 def _check_labels(y: Any, n_series: int, classification: bool) -> np.ndarray:

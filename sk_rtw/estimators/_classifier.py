@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import inspect
 import math
 from typing import Any
 
@@ -12,9 +11,9 @@ from scipy.special import log_softmax, softmax
 from sklearn.base import ClassifierMixin
 from sklearn.utils.validation import check_is_fitted
 
-from ..align._config import check_positive
-from ..manifolds import Manifold
+from ..utils._params import declare_parameters
 from ._averager import RTWAverager, _check_labels, _encode
+from ._params import AVERAGER_DEFAULTS, AVERAGER_PARAMETERS, TEMPERATURE, setting_hint
 
 
 def fit_temperature(distances: np.ndarray, labels: np.ndarray) -> float:
@@ -50,29 +49,32 @@ def fit_temperature(distances: np.ndarray, labels: np.ndarray) -> float:
     return math.exp(best.x)
 
 
+@declare_parameters(
+    (*AVERAGER_PARAMETERS, TEMPERATURE),
+    {**AVERAGER_DEFAULTS, "temperature": "auto"},
+    hint=setting_hint,
+    notes={
+        "n_centroids": "A series gets the class of its nearest centroid (Petitjean et al., "
+        "ICDM 2014: a few DBA centroids per class approach 1-NN DTW at a fraction of its "
+        "cost).",
+    },
+)
 class RTWNearestCentroid(ClassifierMixin, RTWAverager):
     """Nearest-centroid classifier: the class whose RTW mean is nearest by manifold DTW.
 
     ``fit`` learns one Riemannian Time Warping mean per class (as :class:`RTWAverager`);
     ``predict`` returns the class of the nearest mean (paper, section V-A).
 
+    What to set: ``manifold`` for your data, nothing else to start with (density-weighted
+    RTW means of each class's median length, the best nearest-centroid accuracy measured
+    on the UCR development archive); ``method="dba"`` for the fastest fit;
+    ``n_centroids`` for classes of several shapes; ``dtw_window`` to band the DTW;
+    ``preset="paper"`` for the paper's exact configuration. The method's own settings go
+    in its object: ``method=RTW(n_epochs=64)``, searchable as ``method__n_epochs``.
+
     Parameters
     ----------
-    manifold, method, preset, output_length, n_epochs, learning_rate, sinc_window, \
-loss_window, loss_step, penalty, warp_start, n_components, hidden_size, warp_knots, \
-tangent_refinements, mean_iterations, mean_weights, n_iter_no_change, tol, dtw_window, \
-n_jobs, random_state, device, verbose
-        As in :class:`RTWAverager`.
-    n_centroids : int, default=1
-        Centroids per class, as in :class:`RTWAverager` (k-means within each class); a
-        series gets the class of its nearest centroid (Petitjean et al., ICDM 2014: a few
-        DBA centroids per class approach 1-NN DTW at a fraction of its cost).
-    temperature : float or "auto", default="auto"
-        Scale of the distances in :meth:`predict_proba`,
-        ``softmax(-d(x, mean_k) / temperature)``. ``"auto"`` fits it in ``fit`` by
-        minimising the log-loss of the training series (one DTW per training series and
-        class): raw DTW distances are in the data's units, so a fixed scale either
-        saturates to 0/1 rows or flattens to uniform ones. Predictions do not depend on it.
+    %(parameters)s
 
     Attributes
     ----------
@@ -87,6 +89,7 @@ n_jobs, random_state, device, verbose
         One per entry of ``means_``.
     assignments_ : ndarray of shape (n_series,)
         Entry of ``means_`` each training series was averaged into.
+    method_ : str
     manifold_ : Manifold
     temperature_ : float
         The temperature used by :meth:`predict_proba`.
@@ -94,52 +97,14 @@ n_jobs, random_state, device, verbose
     Examples
     --------
     >>> import numpy as np
-    >>> from sk_rtw import RTWNearestCentroid
+    >>> from sk_rtw import RTW, RTWNearestCentroid
     >>> t = np.linspace(0, 1, 40)
     >>> X = np.stack([np.sin(2 * np.pi * t ** p) for p in (0.8, 1.2)]
     ...              + [np.cos(2 * np.pi * t ** p) for p in (0.8, 1.2)])
-    >>> clf = RTWNearestCentroid(n_epochs=10, random_state=0).fit(X, ["sin"] * 2 + ["cos"] * 2)
-    >>> clf.predict(X).tolist()
+    >>> clf = RTWNearestCentroid(method=RTW(n_epochs=10), random_state=0)
+    >>> clf.fit(X, ["sin"] * 2 + ["cos"] * 2).predict(X).tolist()
     ['sin', 'sin', 'cos', 'cos']
     """
-
-    def __init__(
-        self,
-        manifold: str | Manifold = "euclidean",
-        method: str | None = None,
-        preset: str | None = None,
-        output_length: int | None = None,
-        n_epochs: int = 256,
-        learning_rate: float = 0.01,
-        sinc_window: int | str | None = None,
-        loss_window: int | None = None,
-        loss_step: int | None = None,
-        penalty: float | None = None,
-        warp_start: str = "auto",
-        n_components: int = 8,
-        hidden_size: int | str = "auto",
-        warp_knots: int | str | None = "auto",
-        tangent_refinements: int | str = "auto",
-        mean_iterations: int | str = "auto",
-        mean_weights: str = "auto",
-        n_iter_no_change: int | str | None = "auto",
-        tol: float | None = None,
-        n_centroids: int = 1,
-        dtw_window: float | None = None,
-        n_jobs: int | None = None,
-        random_state: Any = None,
-        device: str = "cpu",
-        verbose: int = 0,
-        temperature: float | str = "auto",
-    ):
-        averager = inspect.signature(RTWAverager.__init__).parameters
-        values = locals()
-        super().__init__(**{name: values[name] for name in averager if name != "self"})
-        self.temperature = temperature
-
-    def _check_temperature(self) -> None:
-        if not (isinstance(self.temperature, str) and self.temperature == "auto"):
-            check_positive('temperature (a positive number or "auto")', self.temperature)
 
     def fit(self, X: Any, y: Any = None):
         """Learn one mean per class (and the probability temperature).
@@ -159,9 +124,8 @@ n_jobs, random_state, device, verbose
             raise ValueError(
                 f"{type(self).__name__} requires y to be passed, but the target y is None"
             )
-        self._check_temperature()
         self._fit_means(X, y, require_two_classes=True)
-        if self.temperature == "auto":
+        if isinstance(self.temperature, str):  # "auto", checked with the other parameters
             distances = self.transform(X)
             _, codes = _encode(_check_labels(y, len(distances), True))
             self.temperature_ = fit_temperature(distances, codes)
@@ -240,23 +204,27 @@ n_jobs, random_state, device, verbose
         return -distances
 
 
+@declare_parameters(defaults={"method": "ttw"})
 class TTWNearestCentroid(RTWNearestCentroid):
     """Nearest-centroid classifier on Riemannian TTW class means.
 
-    Same parameters, attributes and input shapes (``(n_series, n_timepoints[,
-    *point_shape])`` or a list of series) as :class:`RTWNearestCentroid`; engine defaults
-    of ``"ttw"``.
+    :class:`RTWNearestCentroid` with ``method="ttw"``: the same attributes and input
+    shapes (``(n_series, n_timepoints[, *point_shape])`` or a list of series).
+
+    Parameters
+    ----------
+    %(parameters)s
     """
 
-    _method = "ttw"
 
-
+@declare_parameters(defaults={"method": "ntw"})
 class NTWNearestCentroid(RTWNearestCentroid):
     """Nearest-centroid classifier on Riemannian NTW class means.
 
-    Same parameters, attributes and input shapes (``(n_series, n_timepoints[,
-    *point_shape])`` or a list of series) as :class:`RTWNearestCentroid`; engine defaults
-    of ``"ntw"``.
-    """
+    :class:`RTWNearestCentroid` with ``method="ntw"``: the same attributes and input
+    shapes (``(n_series, n_timepoints[, *point_shape])`` or a list of series).
 
-    _method = "ntw"
+    Parameters
+    ----------
+    %(parameters)s
+    """

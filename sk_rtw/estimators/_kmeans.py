@@ -1,4 +1,4 @@
-"""k-means of time series on a manifold: assignment by manifold DTW, centres by averaging."""
+"""k-means of time series on a manifold: assignment by manifold DTW, centroids by averaging."""
 
 from __future__ import annotations
 
@@ -9,88 +9,74 @@ from sklearn.base import BaseEstimator, ClusterMixin, TransformerMixin
 from sklearn.utils import check_random_state
 from sklearn.utils.validation import check_is_fitted
 
-from .._numba import check_n_jobs
-from .._random import check_random_state_value
-from ..align._config import check_int, check_positive, check_preset
-from ..dtw import check_window
-from ..manifolds import Manifold
+from ..align._config import DEVICE_PARAMETER, PRESET_PARAMETER
+from ..methods import FitContext, get_method
 from ..utils import check_series_collection
-from ._core import (
-    ENGINE_ARGUMENTS,
-    ENGINE_OPTIONS,
-    ESTIMATOR_METHODS,
-    centre_settings,
-    dtw_to_centres,
-    engine_keywords,
-    kmeans,
-)
+from ..utils._common_params import MANIFOLD, N_JOBS, RANDOM_STATE, VERBOSE
+from ..utils._params import declare_parameters, validate_parameters
+from ._core import dtw_to_centroids, kmeans
+from ._params import DTW_WINDOW, MAX_ITER, METHOD, N_CLUSTERS, N_INIT, TOL, setting_hint
 
-#: Engine settings of the centre fits that ``averager_params`` may set.
-AVERAGER_PARAMS = tuple(
-    name for name in (*ENGINE_ARGUMENTS, *ENGINE_OPTIONS)
-    if name not in ("preset", "n_epochs", "device")
+KMEANS_PARAMETERS = (
+    N_CLUSTERS, METHOD, MANIFOLD, PRESET_PARAMETER, N_INIT, MAX_ITER, TOL, DTW_WINDOW,
+    N_JOBS, RANDOM_STATE, DEVICE_PARAMETER, VERBOSE,
 )  # fmt: skip
+KMEANS_DEFAULTS = {
+    "n_clusters": 3,
+    "method": "rtw",
+    "manifold": "euclidean",
+    "preset": "class-means",
+    "n_init": 1,
+    "max_iter": 10,
+    "tol": 1e-4,
+    "dtw_window": None,
+    "n_jobs": None,
+    "random_state": None,
+    "device": "cpu",
+    "verbose": 0,
+}
 
 
+@declare_parameters(
+    KMEANS_PARAMETERS, KMEANS_DEFAULTS, hint=setting_hint,
+    notes={
+        "method": '"dba" is much faster (no training); the engine\'s methods train one warp '
+        "model per cluster and round.",
+        "verbose": "Here 1: a line per round (inertia, changed assignments, time).",
+    },
+)  # fmt: skip
 class RTWKMeans(ClusterMixin, TransformerMixin, BaseEstimator):
     """k-means clustering of time series on a Riemannian manifold.
 
-    Lloyd's iterations with manifold DTW: every series goes to the centre nearest in
-    manifold DTW, every centre is the time-warping average of its series (RTW, TTW, NTW
+    Lloyd's iterations with manifold DTW: every series goes to the centroid nearest in
+    manifold DTW, every centroid is the time-warping average of its series (RTW, TTW, NTW
     or manifold DBA, as in :class:`RTWAverager`), until the assignment stops changing or
     the inertia improves by less than ``tol``; the best iterate is kept. The distance is
     ``sqrt`` of the DTW with squared geodesic point costs (tslearn's ``dtw`` on Euclidean
     data), so the inertia is the sum of squared-cost DTW values: the objective DBA
-    minimises, and tslearn's ``TimeSeriesKMeans(metric="dtw")`` inertia. Centres start by
+    minimises, and tslearn's ``TimeSeriesKMeans(metric="dtw")`` inertia. Centroids start by
     k-means++ seeding with DTW distances (Arthur and Vassilvitskii, 2007); ``n_init``
     seedings are run and the one with the lowest inertia is kept. A cluster that empties
-    is re-seeded with the series farthest from its centre.
+    is re-seeded with the series farthest from its centroid. The length of the centroids
+    follows the preset's rule (the median length of the cluster's series by default; see
+    the presets table), or the method's ``output_length``.
 
     Parameters
     ----------
-    n_clusters : int, default=3
-    method : {"rtw", "ttw", "ntw", "dba"}, default="rtw"
-        Averaging method of the centres. ``"dba"`` is much faster (no training); the
-        engine's methods train one warp model per cluster and iteration.
-    manifold : str or Manifold, default="euclidean"
-        Space of the samples; a name takes its dimension from the data.
-    n_init : int, default=1
-        k-means++ seedings; the clustering with the lowest inertia is kept.
-    max_iter : int, default=10
-        Assignment/update rounds per seeding.
-    tol : float, default=1e-4
-        Stop when the inertia improves by less than this fraction.
-    output_length : int, optional
-        Length of the centres (default: the longest series; see :class:`RTWAverager`).
-    n_epochs : int, default=256
-        Adam epochs of each centre fit (RTW, TTW, NTW).
-    preset : {"default", "paper"} or None, default=None
-        Engine preset of the centre fits.
-    dtw_window : float in [0, 1], optional
-        Sakoe–Chiba band of every DTW (assignment and DBA).
-    n_jobs : int, optional
-        Centres fitted in parallel and threads of the DTW computations.
-    random_state : int, RandomState or None
-        Seeds the k-means++ seeding and the centre fits.
-    device : str, default="cpu"
-        Torch device of the centre fits.
-    verbose : int, default=0
-        1: a line per iteration (inertia, changed assignments, time); 2: also per centre.
-    averager_params : dict, optional
-        Further engine settings of the centre fits, by their :class:`RTWAverager` names
-        (``learning_rate``, ``hidden_size``, ``warp_start``, ``mean_weights``, ...; an
-        unknown name is a ``TypeError``).
+    %(parameters)s
 
     Attributes
     ----------
     cluster_centers_ : ndarray of shape (n_clusters, Z, *point_shape) or list
-        One centre per cluster, on the manifold (a list when lengths differ).
+        One centroid per cluster, on the manifold (a list when lengths differ).
     labels_ : ndarray of shape (n_series,)
         Cluster of every training series.
     inertia_ : float
-        Sum over the training series of the squared distance to their centre.
+        Sum over the training series of the squared distance to their centroid.
     n_iter_ : int
         Rounds run by the kept seeding (its best iterate is returned).
+    alignments_ : list of Alignment or MultipleAlignment
+        The averaging method's result of every cluster (as :class:`RTWAverager`'s).
     manifold_ : Manifold
     n_features_in_ : int
         Length of the training series when they are univariate of one length.
@@ -108,56 +94,6 @@ class RTWKMeans(ClusterMixin, TransformerMixin, BaseEstimator):
     True
     """
 
-    def __init__(
-        self,
-        n_clusters: int = 3,
-        method: str = "rtw",
-        manifold: str | Manifold = "euclidean",
-        n_init: int = 1,
-        max_iter: int = 10,
-        tol: float = 1e-4,
-        output_length: int | None = None,
-        n_epochs: int = 256,
-        preset: str | None = None,
-        dtw_window: float | None = None,
-        n_jobs: int | None = None,
-        random_state: Any = None,
-        device: str = "cpu",
-        verbose: int = 0,
-        averager_params: dict[str, Any] | None = None,
-    ):
-        self.n_clusters = n_clusters
-        self.method = method
-        self.manifold = manifold
-        self.n_init = n_init
-        self.max_iter = max_iter
-        self.tol = tol
-        self.output_length = output_length
-        self.n_epochs = n_epochs
-        self.preset = preset
-        self.dtw_window = dtw_window
-        self.n_jobs = n_jobs
-        self.random_state = random_state
-        self.device = device
-        self.verbose = verbose
-        self.averager_params = averager_params
-
-    # ------------------------------------------------------------------ fit
-    def _check_params(self) -> None:
-        check_int("n_clusters", self.n_clusters, 1)
-        check_int("n_init", self.n_init, 1)
-        check_int("max_iter", self.max_iter, 1)
-        check_positive("tol", self.tol, allow_zero=True)
-        if self.averager_params is not None and not isinstance(self.averager_params, dict):
-            raise TypeError(
-                f"averager_params must be a dict or None, got {type(self.averager_params)}"
-            )
-        if not isinstance(self.method, str) or self.method.lower() not in ESTIMATOR_METHODS:
-            raise ValueError(f"method must be one of {ESTIMATOR_METHODS}, got {self.method!r}")
-        check_random_state_value(self.random_state)
-        check_n_jobs(self.n_jobs)
-        check_window(self.dtw_window, name="dtw_window")
-
     def fit(self, X: Any, y: Any = None):
         """Cluster the series.
 
@@ -172,57 +108,45 @@ class RTWKMeans(ClusterMixin, TransformerMixin, BaseEstimator):
         -------
         self
         """
-        self._check_params()
+        params = validate_parameters(self)
+        method = get_method(params["method"])
+        method.settings()  # every setting of the method checked before any work
+        self._context = FitContext(
+            preset=params["preset"], dtw_window=params["dtw_window"], device=params["device"],
+            n_jobs=params["n_jobs"], verbose=int(params["verbose"]),
+        )  # fmt: skip
         collection = check_series_collection(X, self.manifold)
-        if collection.n_series < self.n_clusters:
+        n_clusters = params["n_clusters"]
+        if collection.n_series < n_clusters:
             raise ValueError(
-                f"n_clusters={self.n_clusters} needs at least as many series; got "
-                f"{collection.n_series}"
+                f"n_clusters={n_clusters} needs at least as many series; got {collection.n_series}"
             )
-        self._settings = self._centre_settings(collection)
         rng = check_random_state(self.random_state)
         problem = np.zeros(collection.n_series, dtype=np.int64)
         best = None
-        for run in range(self.n_init):
+        for run in range(params["n_init"]):
             (outcome,) = kmeans(
-                collection, problem, [self.n_clusters], self._settings, [rng],
-                max_iter=self.max_iter, tol=self.tol,
-                init_label=f"init {run + 1}/{self.n_init} ",
+                collection, problem, [n_clusters], method, self._context, [rng],
+                max_iter=params["max_iter"], tol=params["tol"],
+                init_label=f"init {run + 1}/{params['n_init']} ", owner="RTWKMeans",
             )  # fmt: skip
             if best is None or outcome.inertia < best.inertia:
                 best = outcome
         assert best is not None
         self.manifold_ = collection.manifold
-        same_length = len({len(c) for c in best.centres}) == 1
-        self.cluster_centers_ = np.stack(best.centres) if same_length else best.centres
+        same_length = len({len(c) for c in best.centroids}) == 1
+        self.cluster_centers_ = np.stack(best.centroids) if same_length else best.centroids
         self.labels_ = best.labels
+        self.alignments_ = best.fits
         self.inertia_ = float(best.inertia)
         self.n_iter_ = best.n_iter
         if collection.equal_length and collection.manifold.point_shape == (1,):
             self.n_features_in_ = collection.max_length
         return self
 
-    def _centre_settings(self, collection):
-        method = self.method.lower()
-        params = dict(self.averager_params or {})
-        unknown = sorted(set(params) - set(AVERAGER_PARAMS))
-        if unknown:
-            raise TypeError(
-                f"averager_params has unknown engine setting(s) {unknown}; known: "
-                f"{list(AVERAGER_PARAMS)}"
-            )
-        check_preset(self.preset)
-        params.update(preset=self.preset, n_epochs=self.n_epochs, device=self.device)
-        return centre_settings(
-            method,
-            engine=engine_keywords(params, output_length=self.output_length),
-            dtw_window=self.dtw_window, n_jobs=self.n_jobs, verbose=self.verbose,
-            owner="RTWKMeans",
-        )  # fmt: skip
-
     # ------------------------------------------------------------ inference
     def transform(self, X: Any) -> np.ndarray:
-        """Manifold-DTW distance of every series to every centre.
+        """Manifold-DTW distance of every series to every centroid.
 
         Parameters
         ----------
@@ -235,10 +159,10 @@ class RTWKMeans(ClusterMixin, TransformerMixin, BaseEstimator):
         """
         check_is_fitted(self, "cluster_centers_")
         collection = check_series_collection(X, self.manifold_, min_length=1)
-        return dtw_to_centres(collection, list(self.cluster_centers_), self._settings)
+        return dtw_to_centroids(collection, list(self.cluster_centers_), self._context)
 
     def predict(self, X: Any) -> np.ndarray:
-        """Index of the nearest centre.
+        """Index of the nearest centroid.
 
         Parameters
         ----------

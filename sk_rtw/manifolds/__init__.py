@@ -1,6 +1,7 @@
 """Riemannian manifolds: geometry for numpy arrays and differentiable torch tensors."""
 
 from ._base import Manifold
+from ._check import ManifoldCheckError, check_manifold
 from ._euclidean import Euclidean
 from ._product import Product
 from ._registry import ManifoldSpec, available_manifolds, get_manifold
@@ -11,10 +12,12 @@ __all__ = [
     "SPD",
     "Euclidean",
     "Manifold",
+    "ManifoldCheckError",
     "ManifoldSpec",
     "Product",
     "Quaternion",
     "Sphere",
     "available_manifolds",
+    "check_manifold",
     "get_manifold",
 ]

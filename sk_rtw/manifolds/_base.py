@@ -10,21 +10,16 @@ array of points has shape ``(*leading, *point_shape)``.
 from __future__ import annotations
 
 import functools
-import warnings
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
 import torch
-from sklearn.exceptions import ConvergenceWarning
 
-from .._backend import numpy_compatible, to_tensor
+from .._backend import numpy_compatible, safe_norm, to_tensor
 from .._random import check_generator
-
-#: Default stopping rule of :meth:`Manifold.mean`.
-MEAN_TOL = 1e-10
-MEAN_MAX_ITER = 64
+from ._mean import MEAN_MAX_ITER, MEAN_TOL, frechet_mean
 
 #: Magnitudes beyond ``10 ** +-EXTREME_EXPONENT`` are aligned in a rescaled frame.
 EXTREME_EXPONENT = 100
@@ -85,8 +80,14 @@ class Manifold(ABC):
     ``(T, *point_shape)`` and a collection ``(n, T, *point_shape)``. numpy input gives
     numpy output; torch input gives differentiable torch output.
 
-    Subclasses implement the torch methods ``_exp``, ``_log``, ``_dist``, ``_norm``,
-    ``_project`` and ``_point_problems``; everything else is derived here.
+    A space of your own needs ``point_shape`` and the torch methods ``_exp`` and ``_log``;
+    the rest is derived (``_norm``: the Euclidean norm of the ambient tangent vector,
+    ``_dist``: the norm of the log, the Fréchet mean, DTW cost matrices) and may be
+    overridden for speed or accuracy: ``_project`` and ``_point_problems`` (the
+    manifold constraint, for clear errors), ``_to_coordinates``/``_from_coordinates`` and
+    ``intrinsic_dim`` (for :mod:`sk_rtw.statistics`), ``_random_point`` and
+    ``_random_tangent`` (for examples). :func:`check_manifold` checks such a space the
+    way the built-in ones are tested; the user guide aligns rotation matrices with one.
     """
 
     #: Registry name of the space.
@@ -111,10 +112,13 @@ class Manifold(ABC):
         return float("inf")
 
     @property
-    @abstractmethod
     def intrinsic_dim(self) -> int:
         """Dimension of the manifold: the number of tangent coordinates (2 on S^2, 3 on
         S^3, ``k (k + 1) / 2`` on SPD(k)), not the size of a point."""
+        raise NotImplementedError(
+            f"{type(self).__name__} does not state its intrinsic_dim (needed by the "
+            "statistics of an aligned set)"
+        )
 
     @property
     def distance_segments(self) -> tuple[tuple[int, int, str], ...] | None:
@@ -136,25 +140,36 @@ class Manifold(ABC):
     @abstractmethod
     def _log(self, p: torch.Tensor, x: torch.Tensor) -> torch.Tensor: ...
 
-    @abstractmethod
-    def _dist(self, p: torch.Tensor, x: torch.Tensor) -> torch.Tensor: ...
+    def _dist(self, p: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
+        """Geodesic distance: the Riemannian norm of the log."""
+        return self._norm(p, self._log(p, x))
 
-    @abstractmethod
-    def _norm(self, p: torch.Tensor, v: torch.Tensor) -> torch.Tensor: ...
+    def _norm(self, p: torch.Tensor, v: torch.Tensor) -> torch.Tensor:
+        """Riemannian norm; by default the Euclidean norm of the ambient tangent vector (the
+        metric induced by the embedding)."""
+        _, v = torch.broadcast_tensors(p, v)
+        return safe_norm(v.reshape(*v.shape[: v.ndim - self.point_ndim], -1))
 
-    @abstractmethod
-    def _project(self, x: torch.Tensor) -> torch.Tensor: ...
+    def _project(self, x: torch.Tensor) -> torch.Tensor:
+        raise NotImplementedError(f"{type(self).__name__} defines no projection onto itself")
 
-    @abstractmethod
-    def _to_coordinates(self, p: torch.Tensor, v: torch.Tensor) -> torch.Tensor: ...
+    def _to_coordinates(self, p: torch.Tensor, v: torch.Tensor) -> torch.Tensor:
+        raise NotImplementedError(
+            f"{type(self).__name__} defines no tangent coordinates (_to_coordinates, needed "
+            "by the statistics of an aligned set)"
+        )
 
-    @abstractmethod
-    def _from_coordinates(self, p: torch.Tensor, c: torch.Tensor) -> torch.Tensor: ...
+    def _from_coordinates(self, p: torch.Tensor, c: torch.Tensor) -> torch.Tensor:
+        raise NotImplementedError(
+            f"{type(self).__name__} defines no tangent coordinates (_from_coordinates, "
+            "needed by the statistics of an aligned set)"
+        )
 
-    @abstractmethod
     def _point_problems(self, x: torch.Tensor, atol: float) -> list[tuple[torch.Tensor, Any]]:
         """Per-point boolean masks of violations (over leading axes) with a description
-        (a string, or a callable that describes the first offending point)."""
+        (a string, or a callable that describes the first offending point). Default: none
+        (only finiteness is checked)."""
+        return []
 
     # ------------------------------------------------------------- public API
     @checked_geometry(points=("p",), vectors=("v",))
@@ -318,15 +333,20 @@ class Manifold(ABC):
         weights: Any = None,
         *,
         axis: int = 0,
+        groups: Any = None,
+        start: Any = None,
         max_iter: int = MEAN_MAX_ITER,
         tol: float = MEAN_TOL,
     ):
-        """Weighted Fréchet (Karcher) mean by Gauss–Newton iterations.
+        """Weighted Fréchet (Karcher) mean by Gauss–Newton iterations, batched over groups.
 
-        Starting from the first sample, each iteration maps all samples to the tangent
-        space at the current estimate, averages them there (weighted) and maps the
-        average back with ``exp``. Stopping rule: the Riemannian norm of the update is
-        below ``tol`` for every mean being computed, or ``max_iter`` iterations were done.
+        Each iteration maps the samples to the tangent space at the current estimate,
+        averages them there (weighted) and maps the average back with ``exp``, from the
+        first sample (of each group) or ``start``. A group stops when none of its means
+        moves by ``tol`` or more; one ``ConvergenceWarning`` if one is still moving after
+        ``max_iter`` iterations (``tol=0``: exactly ``max_iter``, no warning). The same
+        kernel (:func:`sk_rtw.manifolds._mean.frechet_mean`) averages in the engine, DBA
+        and the statistics.
 
         Parameters
         ----------
@@ -334,22 +354,29 @@ class Manifold(ABC):
             Samples; the mean is taken over the leading axis ``axis``.
         weights : array-like, optional
             Non-negative weights, shape ``(n_samples,)`` or broadcastable to the leading
-            axes of ``X`` (after moving ``axis`` first). Default: uniform.
+            axes of ``X`` (after moving ``axis`` first). Default: uniform (per group).
         axis : int, default=0
             Leading axis holding the samples.
+        groups : array-like of int, shape (n_samples,), optional
+            Group of every sample, ``0..n_groups - 1`` with none empty: one mean per
+            group, stacked on a new first axis.
+        start : array-like, optional
+            Starting estimate, shaped like the result.
         max_iter : int, default=64
             Iteration cap.
         tol : float, default=1e-10
-            Convergence threshold on the norm of the Gauss–Newton step.
+            Convergence threshold on the geodesic length of the Gauss–Newton step.
 
         Returns
         -------
-        mean : same type as ``X``, shape of ``X`` without ``axis``.
+        mean : same type as ``X``
+            Shape of ``X`` without ``axis``, with ``(n_groups,)`` in front when ``groups``
+            is given.
         """
         if not isinstance(X, torch.Tensor):
             X = self._check_argument(X, "X", is_point=True)
         return numpy_compatible(_mean_impl)(
-            self, X, weights, axis=axis, max_iter=max_iter, tol=tol
+            self, X, weights, groups, start, axis=axis, max_iter=max_iter, tol=tol
         )
 
     def validate(self, X: Any, *, atol: float = 1e-6, name: str = "X") -> None:
@@ -481,13 +508,11 @@ class Manifold(ABC):
         p = np.asarray(p, dtype=np.float64)
         return self._random_tangent(p, scale, rng)
 
-    @abstractmethod
-    def _random_point(self, leading: tuple[int, ...], rng: np.random.Generator) -> np.ndarray: ...
+    def _random_point(self, leading: tuple[int, ...], rng: np.random.Generator) -> np.ndarray:
+        raise NotImplementedError(f"{type(self).__name__} draws no random points")
 
-    @abstractmethod
-    def _random_tangent(
-        self, p: np.ndarray, scale: float, rng: np.random.Generator
-    ) -> np.ndarray: ...
+    def _random_tangent(self, p: np.ndarray, scale: float, rng: np.random.Generator) -> np.ndarray:
+        raise NotImplementedError(f"{type(self).__name__} draws no random tangent vectors")
 
 
 def _first_index(mask: torch.Tensor) -> str:
@@ -501,6 +526,8 @@ def _mean_impl(
     manifold: Manifold,
     X: torch.Tensor,
     weights: torch.Tensor | None,
+    groups: torch.Tensor | None,
+    start: torch.Tensor | None,
     *,
     axis: int,
     max_iter: int,
@@ -520,9 +547,9 @@ def _mean_impl(
             f"cannot compute the mean of zero samples: X has shape {tuple(X.shape)}, with no "
             f"sample along axis {axis}"
         )
-    if weights is None:
-        w = torch.full((n,), 1.0 / n, dtype=X.dtype, device=X.device)
-    else:
+    codes = None if groups is None else _check_groups(groups, n, X.device)
+    n_groups = 1 if codes is None else int(codes.max()) + 1
+    if weights is not None:
         w = weights.to(dtype=X.dtype, device=X.device)
         if w.ndim == 0 or w.shape[0] != n or w.ndim > n_leading:
             raise ValueError(
@@ -534,28 +561,37 @@ def _mean_impl(
             raise ValueError("weights contain NaN or infinite values")
         if bool((w < 0).any()):
             raise ValueError("weights must be non-negative")
-        total = w.sum(0)
-        if bool((total <= 0).any()):
-            raise ValueError("weights must not all be zero")
-        w = w / total
-    w = w.reshape(*w.shape, *([1] * (X.ndim - w.ndim)))
-    M = X[0]
-    for _ in range(max_iter):
-        step = (w * manifold._log(M.unsqueeze(0), X)).sum(0)
-        M = manifold._exp(M, step)
-        if tol > 0 and float(manifold._norm(M, step).max()) < tol:
-            break
-    else:
-        if tol > 0:
-            warnings.warn(
-                f"the Fréchet mean did not converge in {max_iter} Gauss–Newton iterations "
-                f"(last step {float(manifold._norm(M, step).max()):.3g} > tol={tol:g}); "
-                "raise max_iter or check that the samples are not spread around the cut "
-                "locus",
-                ConvergenceWarning,
-                stacklevel=3,
+        index = torch.zeros(n, dtype=torch.long) if codes is None else codes
+        totals = w.new_zeros(n_groups, *w.shape[1:]).index_add(0, index.to(w.device), w)
+        if bool((totals <= 0).any()):
+            raise ValueError("weights must not all be zero (in any group)")
+        weights = w
+    if start is not None:
+        start = start.to(dtype=X.dtype, device=X.device)
+        expected = (n_groups, *X.shape[1:])
+        if groups is None:
+            start = start.unsqueeze(0)
+        if tuple(start.shape) != expected:
+            raise ValueError(
+                f"start must have shape {expected[1:] if groups is None else expected}, got "
+                f"{tuple(start.shape)[1 if groups is None else 0 :]}"
             )
-    return M
+    mean = frechet_mean(manifold, X, weights, codes, start=start, max_iter=max_iter, tol=tol)
+    return mean if groups is not None else mean[0]
+
+
+def _check_groups(groups: torch.Tensor, n: int, device) -> torch.Tensor:
+    if groups.dtype.is_floating_point and not bool((groups == groups.round()).all()):
+        raise ValueError("groups must be integers, one per sample")
+    codes = groups.to(device=device, dtype=torch.long).reshape(-1)
+    if codes.numel() != n:
+        raise ValueError(f"groups must have one entry per sample ({n}), got {codes.numel()}")
+    if bool((codes < 0).any()):
+        raise ValueError("groups must be non-negative integers")
+    empty = torch.bincount(codes) == 0
+    if bool(empty.any()):
+        raise ValueError(f"groups {torch.nonzero(empty).flatten().tolist()} have no sample")
+    return codes
 
 
 def power_of_two_scale(magnitude: float) -> float | None:

@@ -1,0 +1,82 @@
+"""What every benchmark script starts with: argument types, output checks, method objects.
+
+Each script runs on its own (``python benchmarks/ucr/run.py``); its first lines put the
+repository on ``sys.path`` so that ``benchmarks`` imports, then everything they share
+comes from here. Command-line values are checked by argparse before any work, output
+paths before the first result is computed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import tempfile
+from pathlib import Path
+from typing import Any
+
+import torch
+
+from sk_rtw.methods import AveragingMethod, get_method
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _number(kind, minimum, strict: bool, what: str):
+    def parse(text: str):
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not {what}") from None
+        if value != value or (value <= minimum if strict else value < minimum):
+            raise argparse.ArgumentTypeError(f"{text!r} is not {what}")
+        return value
+
+    parse.__name__ = what  # argparse names the type in its messages
+    return parse
+
+
+#: argparse types: checked on the command line, before any work.
+positive_int = _number(int, 0, True, "a positive integer")
+non_negative_int = _number(int, 0, False, "an integer >= 0")
+positive_float = _number(float, 0.0, True, "a positive number")
+
+
+def existing_directory(text: str) -> str:
+    """argparse type: a folder that exists (data is never downloaded)."""
+    if not Path(text).is_dir():
+        raise argparse.ArgumentTypeError(f"{text!r} is not an existing folder")
+    return text
+
+
+def check_writable(path: str | Path, *, directory: bool = False) -> Path:
+    """``path`` (a file, or a folder with ``directory=True``) can be written: its folder
+    exists or can be made, and a file can be created there. Raises ``SystemExit`` with
+    the reason, before any work."""
+    path = Path(path)
+    folder = path if directory else path.parent
+    if (directory and path.exists() and not path.is_dir()) or (not directory and path.is_dir()):
+        raise SystemExit(f"error: {path} exists and is not a {'folder' if directory else 'file'}")
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        with tempfile.NamedTemporaryFile(dir=folder, prefix=".write-check-"):
+            pass
+    except OSError as exc:
+        raise SystemExit(f"error: cannot write {path}: {exc.strerror or exc}") from None
+    return path
+
+
+def method_object(name: str, **settings: Any) -> AveragingMethod:
+    """The method ``name`` with those of ``settings`` it has (``n_epochs`` means nothing to
+    DBA, so a script can pass its engine settings to every method)."""
+    method = get_method(name)
+    own = method.get_params(deep=False)
+    return method.set_params(**{k: v for k, v in settings.items() if k in own})
+
+
+def machine(device: str = "cpu") -> str:
+    """One line describing where the numbers were measured."""
+    return (
+        f"{platform.machine()}, {os.cpu_count()} cores, torch {torch.__version__}, "
+        f"Python {platform.python_version()}, device {device}"
+    )

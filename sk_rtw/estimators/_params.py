@@ -1,0 +1,87 @@
+"""The estimators' parameters, declared once: what each accepts and means.
+
+A handful of parameters that mean something for every averaging method; every setting
+of a method (the engine's knobs, DBA's iterations) lives in the method object
+(``method=RTW(hidden_size=64)``, searchable as ``method__hidden_size``).
+"""
+
+from __future__ import annotations
+
+from ..align._config import DEVICE_PARAMETER, METHOD_LABELS, PRESET_PARAMETER
+from ..align._knobs import owners
+from ..methods._base import method_parameter
+from ..utils._common_params import MANIFOLD, N_JOBS, RANDOM_STATE, VERBOSE
+from ..utils._params import Constant, Interval, Options, Parameter
+
+METHOD = method_parameter(
+    'Averaging method: "rtw", "ttw", "ntw", "dba" (DTW barycenter averaging with Fréchet '
+    "means, any manifold), or a method object holding settings, e.g. "
+    "RTW(hidden_size=64), searchable as method__hidden_size. A name is the object with "
+    'every setting "auto" (the preset\'s value).'
+)
+N_CENTROIDS = Parameter(
+    "n_centroids",
+    (Interval(int, 1),),
+    "Centroids per class. Above 1 each class is clustered by k-means with the same "
+    "averaging method (k-means++ seeding, at most 10 rounds, at most one centroid per "
+    "series).",
+)
+DTW_WINDOW = Parameter(
+    "dtw_window",
+    (Interval(float, 0.0, 1.0), Constant(None, "no band")),
+    "Sakoe-Chiba band of every DTW (prediction, k-means assignment, DBA), its radius as "
+    "a fraction of the shorter series' length; None: no band. The engine's methods do "
+    "not use it in their fit.",
+)
+TEMPERATURE = Parameter(
+    "temperature",
+    (Interval(float, 0.0, closed="neither"), Options(("auto",))),
+    'Scale of the distances in predict_proba, softmax(-d / temperature). "auto" fits it '
+    "in fit by minimising the log-loss of the training series (raw DTW distances are in "
+    "the data's units: a fixed scale saturates or flattens); predictions do not depend "
+    "on it.",
+)
+N_CLUSTERS = Parameter("n_clusters", (Interval(int, 1),), "Number of clusters.")
+N_INIT = Parameter(
+    "n_init",
+    (Interval(int, 1),),
+    "k-means++ seedings; the clustering with the lowest inertia is kept.",
+)
+MAX_ITER = Parameter("max_iter", (Interval(int, 1),), "Most assignment/update rounds per seeding.")
+TOL = Parameter(
+    "tol",
+    (Interval(float, 0.0),),
+    "Relative improvement of the inertia that counts as progress: a seeding stops at the "
+    "first round below it (or when no series changes cluster).",
+)
+
+#: The parameters of :class:`RTWAverager`, in signature order, with its defaults.
+AVERAGER_PARAMETERS = (
+    MANIFOLD, METHOD, PRESET_PARAMETER, N_CENTROIDS, DTW_WINDOW, N_JOBS, RANDOM_STATE,
+    DEVICE_PARAMETER, VERBOSE,
+)  # fmt: skip
+AVERAGER_DEFAULTS = {
+    "manifold": "euclidean",
+    "method": "rtw",
+    "preset": "class-means",
+    "n_centroids": 1,
+    "dtw_window": None,
+    "n_jobs": None,
+    "random_state": None,
+    "device": "cpu",
+    "verbose": 0,
+}
+
+
+def setting_hint(name: str) -> str:
+    """Where a keyword that is no estimator parameter belongs."""
+    methods = owners(name)
+    if methods:
+        label = METHOD_LABELS[methods[0]]
+        return (
+            f"{name} is a setting of the averaging method: pass it there, "
+            f"method={label}({name}=...), searchable as method__{name}"
+        )
+    if name == "averager_params":
+        return "the averaging settings are the method object's: method=RTW(...)"
+    return "see help() for the parameters"

@@ -1,0 +1,180 @@
+"""The weighted Fréchet mean, batched over groups: the one implementation in the package.
+
+For points ``x_n`` (each with leading axes, e.g. the output times of aligned series) in
+groups ``g(n)`` with non-negative weights ``w_n``, the mean of every group (at every
+leading index) is
+
+``y_g = argmin_y sum_{n in g} w_n dist(y, x_n)^2``,
+
+found by Gauss–Newton steps ``y <- Exp_y(sum_{n in g} w_n Log_y(x_n) / sum_{n in g} w_n)``
+(paper eqs. 14-15 with weights) from the first point of each group or a given start.
+On flat spaces one step is the exact weighted average.
+
+One stopping rule: a group stops when no mean of it moves by ``tol`` or more (geodesic
+distance of the step); with ``tol=0`` exactly ``max_iter`` steps are taken (a fixed
+budget, as DBA and the training loss use). A group still moving after ``max_iter`` steps
+raises one ``ConvergenceWarning``. Groups never interact: a group gets bitwise the same
+mean alone as in a batch (sums run in stacking order whatever the number of groups).
+
+Three ways to differentiate, for torch tensors: ``"all"`` keeps every step on the
+autograd graph; ``"last"`` runs all but the last step without gradient and
+differentiates the last one (from a close start its derivative is the exact mean's up to
+curvature terms of the order of the spread, and exactly on flat spaces); ``"none"``
+records nothing.
+
+:meth:`sk_rtw.manifolds.Manifold.mean` (numpy or torch), the alignment engine (its loss,
+its DTW start, the returned means), DBA and the statistics of an aligned set all call
+:func:`frechet_mean`.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import warnings
+from typing import TYPE_CHECKING
+
+import torch
+from sklearn.exceptions import ConvergenceWarning
+
+if TYPE_CHECKING:
+    from ._base import Manifold
+
+#: Default stopping rule of every Fréchet mean.
+MEAN_TOL = 1e-10
+MEAN_MAX_ITER = 64
+DIFFERENTIATE = ("all", "last", "none")
+
+
+def group_sum(values: torch.Tensor, codes: torch.Tensor, n_groups: int) -> torch.Tensor:
+    """Per-group sums of per-point ``values`` (N, ...) -> (n_groups, ...), in stacking order."""
+    return values.new_zeros(n_groups, *values.shape[1:]).index_add(0, codes, values)
+
+
+def group_expand(values: torch.Tensor, codes: torch.Tensor) -> torch.Tensor:
+    """Per-group ``values`` (n_groups, ...) broadcast to their points -> (N, ...)."""
+    if values.shape[0] == 1:
+        return values.expand(codes.numel(), *values.shape[1:])
+    return values.index_select(0, codes)
+
+
+def first_members(points: torch.Tensor, codes: torch.Tensor, n_groups: int) -> torch.Tensor:
+    """The first point of every group, (n_groups, ...): the default Gauss–Newton start."""
+    n = codes.numel()
+    first = torch.full((n_groups,), n, device=points.device)
+    first = first.scatter_reduce(0, codes, torch.arange(n, device=points.device), "amin")
+    return points.index_select(0, first)
+
+
+def normalised_weights(
+    weights: torch.Tensor | None,
+    codes: torch.Tensor,
+    sizes: torch.Tensor,
+    like: torch.Tensor,
+    n_lead: int,
+) -> torch.Tensor:
+    """Weights summing to one over each group, shaped ``(N, *leading)`` of ``like``."""
+    n_groups = sizes.numel()
+    lead = like.shape[1 : 1 + n_lead]
+    if weights is None:
+        share = (1.0 / sizes.to(like.dtype)).reshape(n_groups, *([1] * n_lead))
+        return group_expand(share, codes).expand(codes.numel(), *lead)
+    weights = weights.to(dtype=like.dtype, device=like.device)
+    weights = weights.reshape(*weights.shape, *([1] * (1 + n_lead - weights.ndim)))
+    return weights / group_expand(group_sum(weights, codes, n_groups), codes)
+
+
+def _step(manifold: Manifold, points, codes, weights, mean, n_groups):
+    w = weights.reshape(*weights.shape, *([1] * manifold.point_ndim))
+    logs = manifold._log(group_expand(mean, codes), points)
+    return manifold._exp(mean, group_sum(w * logs, codes, n_groups))
+
+
+def frechet_mean(
+    manifold: Manifold,
+    points: torch.Tensor,
+    weights: torch.Tensor | None = None,
+    codes: torch.Tensor | None = None,
+    *,
+    start: torch.Tensor | None = None,
+    max_iter: int = MEAN_MAX_ITER,
+    tol: float = MEAN_TOL,
+    differentiate: str = "all",
+    warn: bool = True,
+    sizes: torch.Tensor | None = None,
+) -> torch.Tensor:
+    """Weighted Fréchet mean of each group, at every leading index (module docstring).
+
+    Parameters
+    ----------
+    manifold : Manifold
+    points : torch.Tensor of shape (N, *leading, *point_shape)
+    weights : torch.Tensor of shape (N,) or (N, *leading), optional
+        Non-negative; every group needs a positive total (not checked here). Default:
+        equal weights within each group.
+    codes : torch.Tensor of int64, shape (N,), optional
+        Group of every point, ``0..n_groups - 1``, none empty. Default: one group.
+    start : torch.Tensor of shape (n_groups, *leading, *point_shape), optional
+        Gauss–Newton start (default: the first point of each group).
+    max_iter : int, default=64
+    tol : float, default=1e-10
+        Stop a group when its means move by less than this; 0: exactly ``max_iter`` steps.
+    differentiate : {"all", "last", "none"}, default="all"
+    warn : bool, default=True
+        ``ConvergenceWarning`` when a group is still moving after ``max_iter`` steps.
+    sizes : torch.Tensor of int64, shape (n_groups,), optional
+        Points per group, when known (saves a device synchronisation on a GPU).
+
+    Returns
+    -------
+    torch.Tensor of shape (n_groups, *leading, *point_shape)
+    """
+    if differentiate not in DIFFERENTIATE:
+        raise ValueError(f"differentiate must be one of {DIFFERENTIATE}, got {differentiate!r}")
+    if codes is None:
+        codes = torch.zeros(points.shape[0], dtype=torch.long, device=points.device)
+    sizes = torch.bincount(codes) if sizes is None else sizes
+    n_groups = sizes.numel()
+    n_lead = points.ndim - 1 - manifold.point_ndim
+    recording = torch.no_grad() if differentiate == "none" else contextlib.nullcontext()
+    with recording:
+        w = normalised_weights(weights, codes, sizes, points, n_lead)
+        if manifold.is_flat:  # exact in one step, from any start
+            flat = w.reshape(*w.shape, *([1] * manifold.point_ndim))
+            return group_sum(flat * points, codes, n_groups)
+        mean = first_members(points, codes, n_groups) if start is None else start
+        if differentiate == "all":
+            return _iterate(manifold, points, codes, w, mean, n_groups, max_iter, tol, warn)
+    # "last" and "none": the steps off the graph, then ("last") one differentiated step
+    steps = max_iter - 1 if differentiate == "last" else max_iter
+    with torch.no_grad():
+        mean = _iterate(manifold, points.detach(), codes, w.detach(), mean.detach(), n_groups,
+                        steps, tol, warn)  # fmt: skip
+    if differentiate == "none":
+        return mean
+    return _step(manifold, points, codes, w, mean, n_groups)
+
+
+def _iterate(manifold, points, codes, weights, mean, n_groups, steps, tol, warn):
+    """``steps`` Gauss–Newton steps; with ``tol > 0`` each group stops on its own."""
+    if tol <= 0:
+        for _ in range(steps):
+            mean = _step(manifold, points, codes, weights, mean, n_groups)
+        return mean
+    running = torch.ones(n_groups, dtype=torch.bool, device=points.device)
+    shape = (-1, *([1] * (mean.ndim - 1)))
+    for _ in range(steps):
+        new = _step(manifold, points, codes, weights, mean, n_groups)
+        moved = manifold._dist(mean, new).reshape(n_groups, -1).amax(-1)
+        mean = torch.where(running.view(shape), new, mean)
+        running = running & (moved >= tol)
+        if not bool(running.any()):
+            return mean
+    if warn and steps > 0:
+        warnings.warn(
+            f"the Fréchet mean did not converge in {steps} Gauss–Newton iterations (a step "
+            f"still above tol={tol:g}); raise max_iter or check that the samples are not "
+            "spread around the cut locus",
+            ConvergenceWarning,
+            stacklevel=4,
+        )
+    return mean

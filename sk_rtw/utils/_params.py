@@ -1,0 +1,415 @@
+"""Declared parameters: each one written once, and checked, signed and documented from that.
+
+A :class:`Parameter` is a name, the values it accepts (a tuple of :class:`Constraint`)
+and a one-line description with its unit. A class lists the parameters it takes with
+its own defaults (:func:`declare_parameters`); from that list come
+
+* its ``__init__`` (keyword arguments stored unchanged, scikit-learn's rule; an unknown
+  name is a ``TypeError`` that says where the setting belongs),
+* the check run once at the start of ``fit`` (:func:`validate_parameters`), in the shape
+  of scikit-learn's ``_parameter_constraints`` (written here: that module is private),
+* the "Parameters" section of its docstring.
+
+String options are case-insensitive and come back lower-cased. ``"auto"`` is the one
+sentinel for "the preset's value" and ``None`` for "off" (no band, no early stop, ...).
+"""
+
+from __future__ import annotations
+
+import inspect
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from numbers import Integral, Real
+from typing import Any
+
+import numpy as np
+
+#: The sentinel of every knob whose value a preset gives.
+AUTO = "auto"
+
+
+class InvalidParameterError(ValueError, TypeError):
+    """A parameter value outside what the parameter accepts.
+
+    Both a ``ValueError`` and a ``TypeError``, as scikit-learn's: callers catching either
+    keep working.
+    """
+
+
+class Constraint:
+    """Values a parameter accepts: :meth:`accepts`, a canonical form, two descriptions."""
+
+    #: Numpydoc type, e.g. ``int >= 1``.
+    short: str = "object"
+    #: The same in an error message, e.g. ``an integer >= 1``.
+    description: str = "an object"
+
+    def accepts(self, value: Any) -> bool:
+        raise NotImplementedError
+
+    def normalise(self, name: str, value: Any) -> Any:
+        """The canonical form of an accepted value (may raise a more specific error)."""
+        return value
+
+
+@dataclass(frozen=True)
+class Interval(Constraint):
+    """Integers or finite reals between bounds; ``closed`` says which bounds belong."""
+
+    kind: type  # int or float
+    low: float | None = None
+    high: float | None = None
+    closed: str = "both"  # "both", "left", "right", "neither"
+
+    def accepts(self, value: Any) -> bool:
+        if isinstance(value, (bool, np.bool_)):
+            return False
+        if self.kind is int:
+            if not isinstance(value, Integral):
+                return False
+        elif not isinstance(value, Real) or not math.isfinite(value):
+            return False
+        left = self.closed in ("both", "left")
+        right = self.closed in ("both", "right")
+        if self.low is not None and (value < self.low or (value == self.low and not left)):
+            return False
+        return self.high is None or not (value > self.high or (value == self.high and not right))
+
+    def normalise(self, name: str, value: Any) -> Any:
+        return int(value) if self.kind is int else float(value)
+
+    def _bounds(self) -> str:
+        left = ">=" if self.closed in ("both", "left") else ">"
+        right = "<=" if self.closed in ("both", "right") else "<"
+        if self.low is not None and self.high is not None:
+            lo = "[" if left == ">=" else "("
+            hi = "]" if right == "<=" else ")"
+            return f"in {lo}{_number(self.low)}, {_number(self.high)}{hi}"
+        if self.low is not None:
+            return f"{left} {_number(self.low)}"
+        if self.high is not None:
+            return f"{right} {_number(self.high)}"
+        return ""
+
+    @property
+    def short(self) -> str:  # type: ignore[override]
+        return f"{'int' if self.kind is int else 'float'} {self._bounds()}".strip()
+
+    @property
+    def description(self) -> str:  # type: ignore[override]
+        noun = "an integer" if self.kind is int else "a finite number"
+        return f"{noun} {self._bounds()}".strip()
+
+
+def _number(value: float) -> str:
+    return str(int(value)) if float(value).is_integer() else f"{value:g}"
+
+
+@dataclass(frozen=True)
+class Options(Constraint):
+    """One of a few strings, in any case; normalised to lower case."""
+
+    values: tuple[str, ...]
+
+    def accepts(self, value: Any) -> bool:
+        return isinstance(value, str) and value.lower() in self.values
+
+    def normalise(self, name: str, value: Any) -> Any:
+        return value.lower()
+
+    @property
+    def short(self) -> str:  # type: ignore[override]
+        if len(self.values) == 1:
+            return f'"{self.values[0]}"'
+        return "{" + ", ".join(f'"{v}"' for v in self.values) + "}"
+
+    @property
+    def description(self) -> str:  # type: ignore[override]
+        if len(self.values) == 1:
+            return f'"{self.values[0]}"'
+        return "one of " + ", ".join(f'"{v}"' for v in self.values)
+
+
+@dataclass(frozen=True)
+class Constant(Constraint):
+    """Exactly this value (``None``: "off"); ``meaning`` says what it does."""
+
+    value: Any
+    meaning: str = ""
+
+    def accepts(self, value: Any) -> bool:
+        return value is self.value
+
+    @property
+    def short(self) -> str:  # type: ignore[override]
+        return repr(self.value)
+
+    @property
+    def description(self) -> str:  # type: ignore[override]
+        return repr(self.value) + (f" ({self.meaning})" if self.meaning else "")
+
+
+@dataclass(frozen=True)
+class Boolean(Constraint):
+    short = "bool"
+    description = "True or False"
+
+    def accepts(self, value: Any) -> bool:
+        return isinstance(value, (bool, np.bool_))
+
+    def normalise(self, name: str, value: Any) -> Any:
+        return bool(value)
+
+
+@dataclass(frozen=True)
+class InstanceOf(Constraint):
+    """An instance of one of ``types``; ``normaliser(name, value)`` may refine it."""
+
+    types: tuple[type, ...]
+    short_text: str
+    description_text: str
+    normaliser: Callable[[str, Any], Any] | None = None
+
+    def accepts(self, value: Any) -> bool:
+        return isinstance(value, self.types)
+
+    def normalise(self, name: str, value: Any) -> Any:
+        return value if self.normaliser is None else self.normaliser(name, value)
+
+    @property
+    def short(self) -> str:  # type: ignore[override]
+        return self.short_text
+
+    @property
+    def description(self) -> str:  # type: ignore[override]
+        return self.description_text
+
+
+@dataclass(frozen=True)
+class Satisfies(Constraint):
+    """Any value for which ``predicate`` holds (for rules no interval states)."""
+
+    predicate: Callable[[Any], bool]
+    short_text: str
+    description_text: str
+
+    def accepts(self, value: Any) -> bool:
+        return bool(self.predicate(value))
+
+    @property
+    def short(self) -> str:  # type: ignore[override]
+        return self.short_text
+
+    @property
+    def description(self) -> str:  # type: ignore[override]
+        return self.description_text
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """One declared parameter.
+
+    Attributes
+    ----------
+    name : str
+    constraints : tuple of Constraint
+        The value must satisfy one of them.
+    doc : str
+        What it sets, with its unit (the first line is the summary; more lines may follow).
+    """
+
+    name: str
+    constraints: tuple[Constraint, ...]
+    doc: str
+
+    def check(self, value: Any, name: str | None = None) -> Any:
+        """``value`` in canonical form, or :class:`InvalidParameterError` naming the rule."""
+        return check_value(name or self.name, value, self.constraints)
+
+    def type_doc(self) -> str:
+        return " or ".join(c.short for c in self.constraints)
+
+    def with_auto(self) -> Parameter:
+        """The same parameter accepting ``"auto"`` (the preset's value) as well."""
+        if any(isinstance(c, Options) and c.values == (AUTO,) for c in self.constraints):
+            return self
+        return Parameter(self.name, (*self.constraints, Options((AUTO,))), self.doc)
+
+
+def check_value(name: str, value: Any, constraints: Sequence[Constraint]) -> Any:
+    """The canonical form of ``value`` under the first constraint that accepts it.
+
+    Raises
+    ------
+    InvalidParameterError
+        ``"<name> must be <a> or <b>, got <value>"``.
+    """
+    for constraint in constraints:
+        if constraint.accepts(value):
+            return constraint.normalise(name, value)
+    allowed = " or ".join(c.description for c in constraints)
+    raise InvalidParameterError(f"{name} must be {allowed}, got {value!r}")
+
+
+@dataclass(frozen=True)
+class Declaration:
+    """The parameters of one class, in signature order, with that class's defaults."""
+
+    parameters: tuple[Parameter, ...]
+    defaults: Mapping[str, Any]
+    positional: int = 1
+    hint: Callable[[str], str] | None = field(default=None, compare=False)
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return tuple(p.name for p in self.parameters)
+
+    def __getitem__(self, name: str) -> Parameter:
+        for parameter in self.parameters:
+            if parameter.name == name:
+                return parameter
+        raise KeyError(name)
+
+    def signature(self) -> inspect.Signature:
+        kinds = [
+            inspect.Parameter.POSITIONAL_OR_KEYWORD if i < self.positional
+            else inspect.Parameter.KEYWORD_ONLY
+            for i in range(len(self.parameters))
+        ]  # fmt: skip
+        return inspect.Signature(
+            [inspect.Parameter("self", inspect.Parameter.POSITIONAL_OR_KEYWORD)]
+            + [
+                inspect.Parameter(p.name, kind, default=self.defaults[p.name])
+                for p, kind in zip(self.parameters, kinds, strict=True)
+            ]
+        )
+
+    def docs(self, notes: Mapping[str, str] | None = None) -> str:
+        """The numpydoc "Parameters" entries, one per parameter, with optional notes."""
+        notes = notes or {}
+        lines = []
+        for p in self.parameters:
+            default = self.defaults[p.name]
+            text = f'"{default}"' if isinstance(default, str) else repr(default)
+            lines.append(f"{p.name} : {p.type_doc()}, default={text}")
+            body = p.doc + (f" {notes[p.name]}" if p.name in notes else "")
+            lines.extend("    " + line for line in _wrap(body))
+        return "\n".join(lines)
+
+
+def _wrap(text: str, width: int = 84) -> list[str]:
+    import textwrap
+
+    out: list[str] = []
+    for paragraph in text.split("\n"):
+        out.extend(textwrap.wrap(paragraph, width) or [""])
+    return out
+
+
+PARAMETERS_MARKER = "%(parameters)s"
+
+
+def declare_parameters(
+    parameters: Sequence[Parameter] | None = None,
+    defaults: Mapping[str, Any] | None = None,
+    *,
+    positional: int = 1,
+    hint: Callable[[str], str] | None = None,
+    notes: Mapping[str, str] | None = None,
+):
+    """Class decorator: ``__init__``, the check table and the docs from ``parameters``.
+
+    Parameters
+    ----------
+    parameters : sequence of Parameter, optional
+        In signature order; default: the parent class's declaration (a subclass that only
+        changes ``defaults``).
+    defaults : mapping, optional
+        Default of every parameter (merged over the parent's when ``parameters`` is
+        omitted).
+    positional : int, default=1
+        How many leading parameters may be passed by position.
+    hint : callable, optional
+        ``hint(name)`` is appended to the ``TypeError`` for an unknown keyword.
+    notes : mapping, optional
+        Class-specific text appended to a parameter's documentation.
+
+    The class docstring's ``%(parameters)s`` marker is replaced by the numpydoc entries.
+    """
+
+    def decorate(cls):
+        parent = getattr(cls, "_declaration", None)
+        if parameters is None:
+            if parent is None:
+                raise TypeError(f"{cls.__name__} declares no parameters and inherits none")
+            declaration = Declaration(
+                parent.parameters, {**parent.defaults, **(defaults or {})},
+                parent.positional, hint or parent.hint,
+            )  # fmt: skip
+        else:
+            missing = [p.name for p in parameters if p.name not in (defaults or {})]
+            if missing:
+                raise TypeError(f"{cls.__name__}: no default for {missing}")
+            declaration = Declaration(tuple(parameters), dict(defaults or {}), positional, hint)
+        cls._declaration = declaration
+        cls.__init__ = _make_init(declaration)
+        if cls.__doc__ and PARAMETERS_MARKER in cls.__doc__:
+            block = _indent(declaration.docs(notes), _doc_indent(cls.__doc__))
+            cls.__doc__ = cls.__doc__.replace(PARAMETERS_MARKER, block.lstrip())
+        return cls
+
+    return decorate
+
+
+def _doc_indent(doc: str) -> str:
+    for line in doc.splitlines():
+        if PARAMETERS_MARKER in line:
+            return line[: len(line) - len(line.lstrip())]
+    return ""
+
+
+def _indent(text: str, prefix: str) -> str:
+    return "\n".join(prefix + line if line else line for line in text.splitlines())
+
+
+def _make_init(declaration: Declaration):
+    signature = declaration.signature()
+    names = declaration.names
+
+    def __init__(self, *args, **kwargs):
+        unknown = [k for k in kwargs if k not in names]
+        if unknown:
+            owner = type(self).__name__
+            text = f"{owner}() got an unexpected keyword argument {unknown[0]!r}"
+            if declaration.hint is not None:
+                text += "; " + declaration.hint(unknown[0])
+            raise TypeError(text)
+        bound = signature.bind(self, *args, **kwargs)
+        bound.apply_defaults()
+        for name in names:
+            setattr(self, name, bound.arguments[name])
+
+    __init__.__signature__ = signature  # type: ignore[attr-defined]
+    __init__.__doc__ = "Store the parameters unchanged (checked in ``fit``)."
+    return __init__
+
+
+def validate_parameters(obj: Any, names: Sequence[str] | None = None) -> dict[str, Any]:
+    """Check ``obj``'s declared parameters; their canonical values, by name.
+
+    Parameters
+    ----------
+    obj : object
+        An instance of a class decorated with :func:`declare_parameters`.
+    names : sequence of str, optional
+        Only these parameters (default: all).
+
+    Returns
+    -------
+    dict
+        Parameter name to canonical value (lower-cased options, ints, floats).
+    """
+    declaration: Declaration = type(obj)._declaration
+    wanted = declaration.names if names is None else tuple(names)
+    return {name: declaration[name].check(getattr(obj, name)) for name in wanted}
