@@ -39,7 +39,21 @@ def _number(kind, minimum, strict: bool, what: str):
 #: argparse types: checked on the command line, before any work.
 positive_int = _number(int, 0, True, "a positive integer")
 non_negative_int = _number(int, 0, False, "an integer >= 0")
+output_length = _number(int, 2, False, "an integer >= 2")
 positive_float = _number(float, 0.0, True, "a positive number")
+
+
+def job_count(text: str) -> int:
+    """argparse type: joblib's n_jobs, a non-zero integer (-1: every core)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+    if value == 0:
+        raise argparse.ArgumentTypeError(
+            "0 jobs would run nothing: use 1, N, or -1 for every core"
+        )
+    return value
 
 
 def existing_directory(text: str) -> str:

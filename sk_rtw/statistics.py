@@ -30,6 +30,7 @@ invertible (scikit-learn's ``reg_covar``).
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from typing import Any
 
@@ -97,7 +98,9 @@ class ConfidenceTube:
             + np.sin(angle).reshape(shape) * minor[:, None]
         )
         base = np.broadcast_to(self.mean[:, None], vectors.shape)
-        return np.asarray(manifold.exp(base, vectors))
+        points = np.asarray(manifold.exp(base, vectors))
+        _warn_off_manifold(manifold, points, "the tube's boundary")
+        return points
 
 
 @dataclass(frozen=True, eq=False)
@@ -169,7 +172,9 @@ class AlignedStatistics:
         coords += np.sqrt(self.reg) * rng.standard_normal(coords.shape)
         base = np.broadcast_to(self.mean, (n_samples, *self.mean.shape))
         vectors = self.manifold.from_coordinates(base, coords)
-        return self.manifold.continuous(self.manifold.exp(base, vectors))
+        samples = self.manifold.continuous(self.manifold.exp(base, vectors))
+        _warn_off_manifold(self.manifold, samples, "the samples")
+        return samples
 
     def tube(self, level: float = 0.95) -> ConfidenceTube:
         """The confidence tube holding ``level`` of the Gaussian at every time.
@@ -193,6 +198,7 @@ class AlignedStatistics:
             self.mean[:, None], (len(self.mean), self.dim, *self.mean.shape[1:])
         )
         axes = np.asarray(self.manifold.from_coordinates(base, np.swapaxes(vectors, 1, 2)))
+        _warn_beyond_injectivity(self.manifold, self.mean, axes, half_widths, level)
         return ConfidenceTube(float(level), radius, half_widths, axes, self.mean)
 
     def mahalanobis(self, aligned: Any) -> np.ndarray:
@@ -215,7 +221,16 @@ class AlignedStatistics:
                 f"aligned must have shape (n, {', '.join(map(str, self.mean.shape))}), got "
                 f"{aligned.shape}"
             )
+        self.manifold.validate(aligned, name="aligned")  # NaN, or points off the manifold
         coords = _coordinates(self.manifold, aligned, self.mean)
+        singular = np.linalg.eigvalsh(self.covariance)[:, 0] <= 0
+        if np.any(singular):
+            times = np.flatnonzero(singular)
+            raise ValueError(
+                f"the covariance is singular at {len(times)} of {len(singular)} times (first: "
+                f"{times[:5].tolist()}; the aligned series do not vary there) and reg="
+                f"{self.reg:g}: pass reg > 0 to aligned_statistics for a Mahalanobis distance"
+            )
         solved = np.linalg.solve(self.covariance[None], coords[..., None])[..., 0]
         return np.sqrt(np.clip((coords * solved).sum(-1), 0.0, None))
 
@@ -247,6 +262,39 @@ class AlignedStatistics:
             manifold=factors[index],
             reg=self.reg,
             ddof=self.ddof,
+        )
+
+
+def _warn_off_manifold(manifold: Manifold, points: np.ndarray, what: str) -> None:
+    """A warning when computed points are not valid points of the manifold in float64."""
+    try:
+        manifold.validate(points, name="point")
+    except ValueError as exc:
+        warnings.warn(
+            f"some points of {what} are not valid points of {manifold!r} in float64 "
+            f"({exc}); the spread of the aligned series is too large for the Gaussian in "
+            "the tangent space to be mapped back here",
+            RuntimeWarning,
+            stacklevel=3,
+        )
+
+
+def _warn_beyond_injectivity(manifold, mean, axes, half_widths, level) -> None:
+    """A warning when the tube leaves the region where ``exp`` at the mean is one-to-one."""
+    nd = mean.ndim - 1
+    widest = axes[:, -1] * half_widths[:, -1].reshape(-1, *([1] * nd))
+    with torch.no_grad():
+        beyond = manifold._beyond_injectivity(torch.as_tensor(mean), torch.as_tensor(widest))
+    beyond = beyond.numpy()
+    if np.any(beyond):
+        warnings.warn(
+            f"the {level:g} tube leaves the region where exp at the mean is one-to-one (the "
+            f"injectivity radius {manifold.injectivity_radius:.3g} of {manifold!r}) at "
+            f"{int(beyond.sum())} of {len(beyond)} times (largest half-width "
+            f"{float(half_widths[:, -1].max()):.3g}): its boundary wraps round there and the "
+            "Gaussian in the tangent space does not describe the spread",
+            RuntimeWarning,
+            stacklevel=3,
         )
 
 

@@ -426,3 +426,107 @@ def test_spd_beyond_float64_conditioning_is_rejected_with_its_eigenvalues():
     diagonal = np.stack([np.diag([1e-150 * (1 + t / 10), 1e150]) for t in range(8)])
     clf = RTWNearestCentroid(manifold="spd", method=quick()).fit([diagonal, diagonal * 3], [0, 1])
     assert clf.predict([diagonal * 3]).tolist() == [1] and np.isfinite(clf.means_).all()
+
+
+# ------------------------------------------------------------ defects found by use (27)
+def test_every_setting_is_checked_for_every_method_and_refused_where_it_does_not_belong():
+    """1: a setting a method does not have is refused, naming where it belongs; one it
+    has is checked, DBA's included, before any work."""
+    from sk_rtw import DBA, RTW, RTWKMeans
+
+    with pytest.raises(TypeError, match=r"mean_weights is a setting of the averaging method"):
+        RTWNearestCentroid(method="dba", mean_weights="bad")
+    with pytest.raises(TypeError, match=r"method=RTW\(n_epochs=\.\.\.\)"):
+        RTWNearestCentroid(method="dba", n_epochs=-1)
+    with pytest.raises(TypeError, match="n_epochs is a setting of RTW, TTW, NTW, not of DBA"):
+        DBA(n_epochs=-1)
+    with pytest.raises(TypeError, match="averaging settings are the method object's"):
+        RTWKMeans(method="dba", averager_params={"mean_weights": "bad"})
+    for estimator, words in (
+        (RTWNearestCentroid(method=RTW(mean_weights="bad")), "mean_weights must be one of"),
+        (RTWNearestCentroid(method=DBA(max_iter=0)), "max_iter must be an integer >= 1"),
+        (RTWKMeans(2, method=DBA(tol=-1.0)), "tol must be a finite number >= 0"),
+        (RTWNearestCentroid(method=RTW(n_epochs=-1)), "n_epochs must be an integer >= 0"),
+    ):
+        with pytest.raises(ValueError, match=words):
+            estimator.fit(UNI, LABELS)
+
+
+def _statistics(manifold, aligned, **kwargs):
+    from sk_rtw import aligned_statistics
+
+    return aligned_statistics(aligned=aligned, manifold=manifold, **kwargs)
+
+
+def test_mahalanobis_refuses_nan_and_points_off_the_manifold():
+    """2, 3: NaN named by series and time; points off the manifold named as elsewhere."""
+    stats = _statistics(S2, S2.random_point((5, 10), random_state=0))
+    bad = S2.random_point((2, 10), random_state=1)
+    bad[1, 5, 0] = np.nan
+    with pytest.raises(ValueError, match=r"aligned\[1, 5\] contains NaN"):
+        stats.mahalanobis(bad)
+    quat = _statistics(Quaternion(), QUAT[:, :8])
+    with pytest.raises(ValueError, match="not a point of Quaternion"):
+        quat.mahalanobis(2 * QUAT[:, :8])
+    spd = _statistics(SPD(2), SPD_SERIES[:, :4])
+    indefinite = np.broadcast_to(np.diag([1.0, -1.0]), (1, 4, 2, 2))
+    with pytest.raises(ValueError, match="positive definite"):
+        spd.mahalanobis(indefinite)
+    np.testing.assert_array_less(-1e-12, stats.mahalanobis(S2.random_point((2, 10), 3)))
+
+
+def test_samples_and_tubes_say_when_float64_cannot_hold_them():
+    """4: SPD statistics with eigenvalues 1e-12 / 1e12: samples and tube boundary are not
+    valid points in float64, and a warning says so (and names the first)."""
+    M = SPD(2)
+    spread = [np.diag([1e-12 * (1 + 0.3 * n), 1e12 / (1 + 0.3 * n)]) for n in range(4)]
+    rotation = np.array([[np.cos(0.4), -np.sin(0.4)], [np.sin(0.4), np.cos(0.4)]])
+    aligned = np.stack([np.stack([d] * 6) for d in spread])
+    aligned[1] = rotation @ np.diag([1.0, 1.0]) @ rotation.T  # one series elsewhere
+    stats = _statistics(M, aligned)
+    with pytest.warns(RuntimeWarning, match="the samples are not valid points of SPD"):
+        stats.sample(4, random_state=0)
+    with pytest.warns(RuntimeWarning, match="the tube's boundary are not valid points"):
+        stats.tube(0.9).boundary(M)
+
+
+def test_a_tube_beyond_the_injectivity_radius_is_announced():
+    """5: x and -x on the sphere: half-widths beyond pi, a boundary that wraps round."""
+    p = S2.random_point(7, random_state=1)
+    stats = _statistics(S2, np.stack([p, -p]))
+    with pytest.warns(RuntimeWarning, match="injectivity radius 3.14 of Sphere"):
+        tube = stats.tube(0.9)
+    assert tube.half_widths.max() > np.pi
+    with warnings.catch_warnings():  # a tight set stays inside: no warning
+        warnings.simplefilter("error")
+        _statistics(S2, S2.random_point((5, 7), random_state=2) * 0 + p).tube(0.9)
+
+
+def test_a_singular_covariance_names_reg():
+    p = S2.random_point(7, random_state=1)
+    stats = _statistics(S2, np.stack([p, p, p]), reg=0.0)
+    with pytest.raises(ValueError, match="reg=0: pass reg > 0"):
+        stats.mahalanobis(p[None])
+    assert np.isfinite(_statistics(S2, np.stack([p, p, p])).mahalanobis(p[None])).all()
+
+
+def test_an_spd_alignment_float64_cannot_follow_names_the_eigenvalue_range():
+    """9: diagonal (valid) points whose geodesics overflow: the eigenvalue range is named,
+    not a NaN that the data does not contain."""
+    D = np.diag([1e-150, 1e150])
+    X = np.stack([np.stack([D if t % 2 else D[::-1, ::-1] for t in range(8)])] * 3)
+    with pytest.raises(ValueError, match=r"eigenvalues run from 1e-150 to 1e\+150"):
+        align(X, manifold="spd", n_epochs=2)
+
+
+def test_an_object_array_of_unequal_series_reads_like_the_list():
+    """12: np.array(list_of_series, dtype=object) is what many pipelines hand over."""
+    series = [np.sin(np.linspace(0, 6, n)) for n in (30, 40)]
+    series += [np.cos(np.linspace(0, 6, n)) for n in (25, 35)]
+    packed = np.empty(len(series), dtype=object)
+    packed[:] = series
+    from_list = RTWNearestCentroid(method="dba").fit(series, [0, 0, 1, 1])
+    from_array = RTWNearestCentroid(method="dba").fit(packed, [0, 0, 1, 1])
+    for a, b in zip(from_list.means_, from_array.means_, strict=True):
+        np.testing.assert_array_equal(a, b)
+    np.testing.assert_array_equal(from_array.predict(packed), [0, 0, 1, 1])

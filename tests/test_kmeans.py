@@ -236,3 +236,19 @@ def test_distances_to_every_centroid_are_features_for_a_pipeline():
     search = GridSearchCV(pipe, {"centroids__n_centroids": [1, 2]}, cv=3).fit(X, y)
     k = search.best_params_["centroids__n_centroids"]
     assert search.best_estimator_[0].transform(X).shape[1] == 2 * k  # the searched k reached it
+
+
+def test_the_documented_centroid_length_is_the_one_used():
+    """Issue 27, 6: the docstring states the preset's rule; the centroids follow it."""
+    from sk_rtw.align import PRESETS
+
+    rule = PRESETS[RTWKMeans().preset].output_length
+    assert rule.formula in " ".join(RTWKMeans.__doc__.split())
+    rng = np.random.default_rng(0)
+    lengths = [15, 16, 18, 22, 17, 21]
+    X = [np.sin(np.linspace(0, 3, n)) + 0.01 * rng.standard_normal(n) for n in lengths[:3]]
+    X += [np.cos(np.linspace(0, 3, n)) + 0.01 * rng.standard_normal(n) for n in lengths[3:]]
+    km = RTWKMeans(2, method=quick(), random_state=0).fit(X)
+    for k in range(2):
+        members = np.asarray(lengths)[km.labels_ == k]
+        assert len(km.cluster_centers_[k]) == rule(members)

@@ -121,3 +121,36 @@ def test_imitation_models_reproduce_identical_demonstrations(space):
         assert dtw_distance(dmp[:, cols], demo[:, cols], manifold=part, normalize="path") < (
             0.3 * scale
         )
+
+
+# ------------------------------------------------------------ command-line checks (27)
+def test_imitation_reads_only_the_tasks_asked_for_and_names_a_missing_file(tmp_path):
+    """10: an empty data folder and --tasks rcfs: the RCFS file is named with the
+    folder it was looked for in, before any work; no other task's file is read."""
+    from benchmarks.paper import imitation
+
+    with pytest.raises(SystemExit, match=r"no C\.npy in .*rcfs/2Dletters") as info:
+        imitation.main(["--data-dir", str(tmp_path), "--tasks", "rcfs", "--quick"])
+    assert "CarrotGrating" not in str(info.value)
+
+
+@pytest.mark.parametrize("script", ["imitation", "pose", "spd", "quaternion_s3", "inverted_s1"])
+def test_an_unwritable_markdown_path_stops_the_run_before_any_work(script, tmp_path):
+    """11: checked on the command line, not after the first task (minutes)."""
+    import importlib
+
+    module = importlib.import_module(f"benchmarks.paper.{script}")
+    blocker = tmp_path / "a file"
+    blocker.write_text("")
+    with pytest.raises(SystemExit, match="cannot write"):
+        module.main(["--markdown", str(blocker / "tables.md"), "--epochs", "1"])
+
+
+def test_settings_of_the_paper_runs_are_checked_on_the_command_line(capsys):
+    with pytest.raises(SystemExit, match="'bogus' is no setting"):
+        inverted_s1.main(["--options", '{"bogus": 1}', "--trials", "1"])
+    with pytest.raises(SystemExit, match="hidden_size must be an integer >= 1"):
+        inverted_s1.main(["--options", '{"hidden_size": 0}', "--trials", "1"])
+    with pytest.raises(SystemExit):
+        inverted_s1.main(["--epochs", "-3"])
+    assert "is not an integer >= 0" in capsys.readouterr().err

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -124,3 +125,134 @@ def test_one_or_two_methods_finish_with_summary_and_verdict(methods, tmp_path, c
     assert "critical-difference diagram not drawn: it needs at least 3 methods" in printed
     assert "Verdict over 4 dataset(s)" in printed
     assert (out / "summary.md").is_file() and not (out / "critical_difference.png").exists()
+
+
+# ------------------------------------------------------------ command-line checks (27)
+@pytest.mark.parametrize(
+    ("args", "words"),
+    [
+        (["--data-dir", "/no/such/folder", "--all"], "is not an existing folder"),
+        (["--epochs", "-1"], "'-1' is not an integer >= 0"),
+        (["--max-series-per-class", "0"], "'0' is not a positive integer"),
+        (["--time-budget", "-1"], "'-1' is not a positive number"),
+        (["--jobs", "0"], "0 jobs would run nothing"),
+        (["--output-length", "1"], "is not an integer >= 2"),
+        (["--device", "gpu"], "torch device"),
+        (["--scheduler", "tcp://host:8786"], "only with --backend dask"),
+        (["--backend", "spark"], "is not one of"),
+    ],
+)
+def test_nonsense_on_the_command_line_stops_before_any_work(args, words, tmp_path, capsys):
+    with pytest.raises(SystemExit) as info:
+        main([*args, "--out", str(tmp_path / "out"), "--quiet"])
+    assert info.value.code == 2 and words in capsys.readouterr().err
+    assert not (tmp_path / "out" / "datasets").exists()  # nothing was run
+
+
+def test_an_output_folder_that_cannot_be_written_stops_the_run_first(tmp_path):
+    blocker = tmp_path / "a file"
+    blocker.write_text("")
+    with pytest.raises(SystemExit, match="exists and is not a folder"):
+        main(["--datasets", "ItalyPowerDemand", "--methods", "dba", "--out", str(blocker)])
+
+
+def test_a_method_that_fails_everywhere_fails_the_run(tmp_path, monkeypatch, capsys):
+    import benchmarks.ucr._protocol as protocol
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("no averaging today")
+
+    monkeypatch.setattr(protocol, "_fit_estimator", broken)
+    args = ["--datasets", "ItalyPowerDemand", "--methods", "dba", "1nn-dtw",
+            "--max-series-per-class", "4", "--out", str(tmp_path), "--quiet"]  # fmt: skip
+    assert main(args) == 1
+    assert "every fit of dba failed" in capsys.readouterr().err
+    record = json.loads((tmp_path / "datasets" / "ItalyPowerDemand.json").read_text())
+    assert record["methods"]["1nn-dtw"]["accuracy"] > 0  # the other method still ran
+
+
+def test_the_documented_output_length_is_the_one_used(tmp_path, capsys):
+    """6: --help states the preset's rule; the means of a run have that length."""
+    from sk_rtw.align import PRESETS
+
+    rule = PRESETS["class-means"].output_length
+    with pytest.raises(SystemExit):
+        main(["--help"])
+    assert rule.formula in " ".join(capsys.readouterr().out.split())
+    args = ["--datasets", "PickupGestureWiimoteZ", "--methods", "rtw", "--epochs", "1",
+            "--max-series-per-class", "3", "--out", str(tmp_path), "--quiet"]  # fmt: skip
+    assert main(args) == 0
+    record = json.loads((tmp_path / "datasets" / "PickupGestureWiimoteZ.json").read_text())
+    split = load_split("PickupGestureWiimoteZ", "train", None)
+    kept = np.asarray(record["train_index"])
+    expected = [rule(split.lengths[kept][split.y[kept] == c])
+                for c in record["methods"]["rtw"]["classes"]]  # fmt: skip
+    assert record["methods"]["rtw"]["output_length"] == expected
+
+
+def _start(command, log, env):
+    import subprocess
+
+    return subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT, env=env,
+                            cwd=log.name.rsplit("/", 1)[0])  # fmt: skip
+
+
+@pytest.mark.slow
+def test_a_run_on_a_dask_cluster_started_the_usual_way(tmp_path, capsys):
+    """13: a scheduler and a worker started as separate processes, with sk_rtw installed
+    and nothing of this repository importable; then a worker that lacks aeon."""
+    import os
+    import shutil
+    import subprocess
+    import sys
+    import time
+
+    dask = shutil.which("dask") or str(Path(sys.executable).parent / "dask")
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    file = tmp_path / "scheduler.json"
+    processes = []
+    try:
+        scheduler = [dask, "scheduler", "--host", "127.0.0.1", "--port", "0",
+                     "--no-dashboard", "--scheduler-file", str(file)]  # fmt: skip
+        with open(tmp_path / "scheduler.log", "w") as log:
+            processes.append(_start(scheduler, log, env))
+        for _ in range(60):
+            if file.is_file() and file.stat().st_size:
+                break
+            time.sleep(0.5)
+        worker = [dask, "worker", "--scheduler-file", str(file), "--nworkers", "1",
+                  "--nthreads", "1", "--no-dashboard", "--memory-limit", "0"]  # fmt: skip
+        with open(tmp_path / "worker.log", "w") as log:
+            processes.append(_start(worker, log, env))
+        address = json.loads(file.read_text())["address"]
+        args = ["--datasets", "ItalyPowerDemand", "GunPoint", "--methods", "dba",
+                "--max-series-per-class", "4", "--backend", "dask", "--scheduler", address,
+                "--jobs", "2", "--quiet"]  # fmt: skip
+        assert main([*args, "--out", str(tmp_path / "run")]) == 0
+        for name in ("ItalyPowerDemand", "GunPoint"):
+            record = json.loads((tmp_path / "run" / "datasets" / f"{name}.json").read_text())
+            assert record["error"] is None and record["methods"]["dba"]["accuracy"] > 0
+        # a worker whose environment lacks aeon: named, within seconds, nothing run
+        fake = tmp_path / "fake" / "aeon"
+        fake.mkdir(parents=True)
+        (fake / "__init__.py").write_text('raise ImportError("not installed")\n')
+        with open(tmp_path / "fake" / "worker.log", "w") as log:
+            processes.append(_start([*worker, "--name", "without-aeon"], log,
+                                    {**env, "PYTHONPATH": str(tmp_path / "fake")}))  # fmt: skip
+        from dask.distributed import Client
+
+        with Client(address, timeout=10) as client:
+            client.wait_for_workers(2, timeout=60)
+        start = time.perf_counter()
+        with pytest.raises(SystemExit, match=r"worker tcp://\S+ cannot import aeon"):
+            main([*args, "--out", str(tmp_path / "run2")])
+        assert time.perf_counter() - start < 30
+        assert not (tmp_path / "run2" / "datasets").exists()
+    finally:
+        for process in processes:
+            process.terminate()
+        for process in processes:
+            try:
+                process.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                process.kill()

@@ -20,7 +20,7 @@ from sk_rtw import align, metrics
 from sk_rtw.align import ENGINE_METHODS
 from sk_rtw.baselines import dba_average, mmddtw_align, pdtw_average, qdtw_align
 
-from .._shared import method_object
+from .._shared import check_writable, existing_directory, method_object, non_negative_int
 
 LABELS = {
     "rtw": "RTW",
@@ -42,6 +42,49 @@ LABELS = {
 
 #: Extra keyword arguments of ``sk_rtw.align`` for TTW, NTW and RTW (``--options``).
 ENGINE_OPTIONS: dict = {}
+
+
+def paper_parser(
+    doc: str, *, data: bool = True, engine: bool = True, epilog: str | None = None
+) -> argparse.ArgumentParser:
+    """The options every paper experiment shares (data, epochs, seed, output; with
+    ``engine`` the device and the engine settings); each script adds its own."""
+    parser = argparse.ArgumentParser(
+        description=doc.splitlines()[0],
+        epilog=epilog,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    if data:
+        parser.add_argument(
+            "--data-dir",
+            type=existing_directory,
+            help="shared data folder (default: $SK_RTW_DATA_DIR, else ../shared/data)",
+        )
+    parser.add_argument("--epochs", type=non_negative_int, default=256,
+                        help="most epochs of TTW, NTW and RTW (default 256)")  # fmt: skip
+    parser.add_argument("--seed", type=non_negative_int, default=0)
+    if engine:
+        parser.add_argument("--device", default="cpu", help="torch device of TTW, NTW, RTW")
+        add_engine_options(parser)
+    parser.add_argument("--markdown", help="also write the tables to this Markdown file")
+    return parser
+
+
+def parse_paper_args(parser: argparse.ArgumentParser, argv=None) -> argparse.Namespace:
+    """Parse, then check what argparse cannot (settings, device, the output file) before
+    any work."""
+    from sk_rtw.align._config import check_device
+
+    args = parser.parse_args(argv)
+    if hasattr(args, "options"):
+        apply_engine_options(args)
+        try:
+            check_device(args.device)
+        except ValueError as exc:
+            parser.error(str(exc))
+    if args.markdown:
+        check_writable(args.markdown)
+    return args
 
 
 def add_engine_options(parser: argparse.ArgumentParser) -> None:

@@ -27,9 +27,20 @@ def data_dir(path: str | None = None) -> Path:
     return candidate
 
 
+def required(root: Path, *parts: str) -> Path:
+    """The file ``root/parts``, or a ``FileNotFoundError`` naming it and its folder."""
+    path = Path(root).joinpath(*parts)
+    if not path.is_file():
+        raise FileNotFoundError(
+            f"no {path.name} in {path.parent} (the demonstrations are read from --data-dir "
+            f"or ${ENV_DATA_DIR}: {Path(root)}; see the data README there)"
+        )
+    return path
+
+
 def rcfs_letter(root: Path, letter: str = "G") -> np.ndarray:
     """2-D positions of the RCFS handwritten letter demonstrations, ``(n, 200, 2)``."""
-    return np.load(root / "rcfs" / "2Dletters" / f"{letter}.npy")[:, :, :2]
+    return np.load(required(root, "rcfs", "2Dletters", f"{letter}.npy"))[:, :, :2]
 
 
 def rlasa_shapes(root: Path) -> list[str]:
@@ -40,7 +51,7 @@ def rlasa_quaternions(root: Path, shape: str) -> np.ndarray:
     """R-LASA unit-quaternion demonstrations ``(4, 1000, 4)``, w first."""
     from scipy.io import loadmat
 
-    demos = loadmat(root / "r_lasa" / "UQ" / f"{shape}_UQ.mat")["demoUQ"][0]
+    demos = loadmat(required(root, "r_lasa", "UQ", f"{shape}_UQ.mat"))["demoUQ"][0]
     return np.stack([d["quat"][0, 0].T for d in demos])
 
 
@@ -48,7 +59,7 @@ def rlasa_spd(root: Path, shape: str) -> np.ndarray:
     """R-LASA SPD(2) demonstrations ``(4, 1000, 2, 2)``."""
     from scipy.io import loadmat
 
-    demos = loadmat(root / "r_lasa" / "SPD" / f"{shape}_SPD.mat")["demoSPD"][0]
+    demos = loadmat(required(root, "r_lasa", "SPD", f"{shape}_SPD.mat"))["demoSPD"][0]
     return np.stack([np.moveaxis(d["spd"][0, 0], -1, 0) for d in demos])
 
 
@@ -84,7 +95,7 @@ def icsc_carrot_grating(root: Path) -> list[np.ndarray]:
     """The 12 carrot-grating poses ``(T_i, 7)``: x, y, z, qw, qx, qy, qz."""
     from scipy.io import loadmat
 
-    m = loadmat(root / "icsc_hmm" / "CarrotGrating_robot.mat")
+    m = loadmat(required(root, "icsc_hmm", "CarrotGrating_robot.mat"))
     return [np.asarray(m["Data"][0, i], dtype=float) for i in range(m["Data"].shape[1])]
 
 
@@ -97,7 +108,7 @@ def icsc_wiping(root: Path) -> list[np.ndarray]:
     """
     from scipy.io import loadmat
 
-    m = loadmat(root / "icsc_hmm" / "circular_wiping_dataset.mat")
+    m = loadmat(required(root, "icsc_hmm", "circular_wiping_dataset.mat"))
     poses = []
     for demo in m["proc_data"][0]:
         H, X = demo["H"][0, 0], demo["X"][0, 0]

@@ -54,7 +54,6 @@ shapes in S^3 (4 demonstrations, every 10th sample: 100); RCFS letters in R^2 (t
 
 from __future__ import annotations
 
-import argparse
 import sys
 import time
 import warnings
@@ -66,7 +65,15 @@ ROOT = Path(__file__).resolve().parents[2]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from benchmarks.paper._common import LABELS, run_method, unaligned, write_markdown  # noqa: E402
+from benchmarks._shared import positive_int  # noqa: E402
+from benchmarks.paper._common import (  # noqa: E402
+    LABELS,
+    paper_parser,
+    parse_paper_args,
+    run_method,
+    unaligned,
+    write_markdown,
+)
 from benchmarks.paper._data import (  # noqa: E402
     data_dir,
     icsc_carrot_grating,
@@ -91,19 +98,23 @@ RCFS_LETTERS = ("C", "G", "S", "W")
 
 
 # ---------------------------------------------------------------- datasets
-def tasks(root: Path, quick: bool) -> dict[str, tuple[Manifold, list[list[np.ndarray]]]]:
-    """Every task: its manifold and its groups of demonstrations (shapes, letters)."""
-    grating = [s[::10] for s in icsc_carrot_grating(root)]
-    wiping = [s[::5] for s in icsc_wiping(root)]
-    shapes = RLASA_SHAPES[:2] if quick else RLASA_SHAPES
+TASKS = ("grating", "wiping", "r-lasa", "rcfs")
+
+
+def load_task(task: str, root: Path, quick: bool) -> tuple[Manifold, list[list[np.ndarray]]]:
+    """One task: its manifold and its groups of demonstrations (shapes, letters); only its
+    own files are read (a missing one is named with the folder it was looked for in)."""
+    if task == "grating":
+        grating = [s[::10] for s in icsc_carrot_grating(root)]
+        return POSE, [grating[::3] if quick else grating]
+    if task == "wiping":
+        return POSE, [[s[::5] for s in icsc_wiping(root)]]
+    if task == "r-lasa":
+        shapes = RLASA_SHAPES[:2] if quick else RLASA_SHAPES
+        return Quaternion(), [list(rlasa_quaternions(root, s)[:, ::10]) for s in shapes]
     letters = RCFS_LETTERS[:1] if quick else RCFS_LETTERS
     n_letter = 5 if quick else 8
-    return {
-        "grating": (POSE, [grating[::3] if quick else grating]),
-        "wiping": (POSE, [wiping]),
-        "r-lasa": (Quaternion(), [list(rlasa_quaternions(root, s)[:, ::10]) for s in shapes]),
-        "rcfs": (Euclidean(2), [list(rcfs_letter(root, c)[:n_letter]) for c in letters]),
-    }
+    return Euclidean(2), [list(rcfs_letter(root, c)[:n_letter]) for c in letters]
 
 
 def factors(manifold: Manifold) -> dict[str, tuple[slice, Manifold]]:
@@ -310,31 +321,28 @@ def table(result: dict, preparations, models) -> str:
 
 
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(
-        description=__doc__.splitlines()[0],
-        epilog=__doc__.split("Usage::")[1].split("Needs the")[0],
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+    parser = paper_parser(
+        __doc__, engine=False, epilog=__doc__.split("Usage::")[1].split("Needs the")[0]
     )
-    parser.add_argument("--data-dir", help="shared data folder (default: ../shared/data)")
-    parser.add_argument("--tasks", nargs="+", default=["grating", "wiping", "r-lasa", "rcfs"],
-                        choices=["grating", "wiping", "r-lasa", "rcfs"])  # fmt: skip
+    parser.add_argument("--tasks", nargs="+", default=list(TASKS), choices=list(TASKS))
     parser.add_argument("--preparations", nargs="+", default=list(PREPARATIONS),
                         choices=list(PREPARATIONS))  # fmt: skip
     parser.add_argument("--models", nargs="+", default=list(MODELS), choices=list(MODELS))
-    parser.add_argument("--epochs", type=int, default=256)
-    parser.add_argument("--folds", type=int, default=None, help="first folds only")
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--markdown", help="also write the tables to this Markdown file")
+    parser.add_argument("--folds", type=positive_int, default=None, help="first folds only")
     parser.add_argument(
         "--quick", action="store_true",
         help="4 grating demonstrations, 2 R-LASA shapes, 1 RCFS letter of 5, 64 epochs",
     )  # fmt: skip
-    args = parser.parse_args(argv)
+    args = parse_paper_args(parser, argv)
     if args.quick:
         args.epochs = min(args.epochs, 64)
     root = data_dir(args.data_dir)
     started = time.perf_counter()
-    selected = [task for task in tasks(root, args.quick) if task in args.tasks]
+    selected = [task for task in TASKS if task in args.tasks]
+    try:  # every file the run needs, read before the first (minutes-long) task
+        loaded = {task: load_task(task, root, args.quick) for task in selected}
+    except FileNotFoundError as exc:
+        raise SystemExit(f"error: {exc}") from None
     sections: dict[str, str] = {}
 
     def write(done: bool) -> None:
@@ -354,9 +362,7 @@ def main(argv=None) -> None:
             quiet=not done,
         )
 
-    for task, (manifold, groups) in tasks(root, args.quick).items():
-        if task not in selected:
-            continue
+    for task, (manifold, groups) in loaded.items():
         result = evaluate(task, manifold, groups, args.preparations, args.models, args)
         sizes = sorted({len(g) for g in groups})
         lengths = sorted({len(d) for g in groups for d in g})

@@ -20,7 +20,6 @@ NTW, RTW; DBA (Fréchet-mean DBA) as an extra reference in both.
 
 from __future__ import annotations
 
-import argparse
 import sys
 from pathlib import Path
 
@@ -30,10 +29,11 @@ ROOT = Path(__file__).resolve().parents[2]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
+from benchmarks._shared import positive_int  # noqa: E402
 from benchmarks.paper._common import (  # noqa: E402
-    add_engine_options,
-    apply_engine_options,
     markdown_table,
+    paper_parser,
+    parse_paper_args,
     run_method,
     score,
     unaligned,
@@ -100,21 +100,16 @@ def run(n_signals, methods, trials, epochs, output_length, device, seed):
 
 
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--n-signals", type=int, nargs="+", default=[4, 30])
+    parser = paper_parser(__doc__, data=False)
+    parser.add_argument("--n-signals", type=positive_int, nargs="+", default=[4, 30])
     parser.add_argument("--methods", nargs="+", help="default: the paper's table plus DBA")
-    parser.add_argument("--trials", type=int, default=100, help="paper: 100")
-    parser.add_argument("--epochs", type=int, default=256)
+    parser.add_argument("--trials", type=positive_int, default=100, help="paper: 100")
     parser.add_argument(
-        "--output-lengths", type=int, nargs="+", default=[None], help="Z (default: min(N, 4) T)"
-    )
-    parser.add_argument("--device", default="cpu")
-    add_engine_options(parser)
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--markdown", help="also write the tables to this Markdown file")
+        "--output-lengths", type=positive_int, nargs="+", default=[None],
+        help="Z (default: the preset's, min(N, 4) T for RTW/TTW/NTW)",
+    )  # fmt: skip
     parser.add_argument("--quick", action="store_true", help="1 trial, 64 epochs")
-    args = parser.parse_args(argv)
-    apply_engine_options(args)
+    args = parse_paper_args(parser, argv)
     if args.quick:
         args.trials, args.epochs = 1, 64
     sections = {}

@@ -22,7 +22,6 @@ tool frames.
 
 from __future__ import annotations
 
-import argparse
 import sys
 from pathlib import Path
 
@@ -32,11 +31,12 @@ ROOT = Path(__file__).resolve().parents[2]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
+from benchmarks._shared import check_writable  # noqa: E402
 from benchmarks.paper._common import (  # noqa: E402
     LABELS,
-    add_engine_options,
-    apply_engine_options,
     markdown_table,
+    paper_parser,
+    parse_paper_args,
     run_method,
     score,
     unaligned,
@@ -120,23 +120,18 @@ def draw(task: str, series, outcomes: dict, path: Path) -> None:
 
 
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--data-dir", help="shared data folder (default: ../shared/data)")
+    parser = paper_parser(__doc__)
     parser.add_argument("--tasks", nargs="+", default=list(TASKS), choices=list(TASKS))
     parser.add_argument("--methods", nargs="+", default=["ttw", "ntw", "rtw", "dba"])
-    parser.add_argument("--epochs", type=int, default=256)
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--device", default="cpu")
-    add_engine_options(parser)
-    parser.add_argument("--markdown", help="also write the tables to this Markdown file")
     parser.add_argument("--figure-dir", help="write pose_<task>.png figures here")
     parser.add_argument("--quick", action="store_true", help="64 epochs, 4 grating demos")
     parser.add_argument(
         "--full-resolution", action="store_true",
         help="every sample (grating 2,322-3,371, wiping 1,096-1,457) instead of every 10th / 5th",
     )  # fmt: skip
-    args = parser.parse_args(argv)
-    apply_engine_options(args)
+    args = parse_paper_args(parser, argv)
+    if args.figure_dir:
+        check_writable(args.figure_dir, directory=True)
     root = data_dir(args.data_dir)
     if args.quick:
         args.epochs = 64

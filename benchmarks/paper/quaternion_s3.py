@@ -18,7 +18,6 @@ R-LASA shapes.
 
 from __future__ import annotations
 
-import argparse
 import sys
 from pathlib import Path
 
@@ -26,11 +25,12 @@ ROOT = Path(__file__).resolve().parents[2]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
+from benchmarks._shared import positive_float, positive_int  # noqa: E402
 from benchmarks.paper._common import (  # noqa: E402
-    add_engine_options,
-    apply_engine_options,
     evaluate,
     markdown_table,
+    paper_parser,
+    parse_paper_args,
     write_markdown,
 )
 from benchmarks.paper._data import (  # noqa: E402
@@ -47,23 +47,18 @@ COLUMNS = ("BL", "AQ", "seconds")
 
 
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--data-dir", help="shared data folder (default: ../shared/data)")
+    parser = paper_parser(__doc__)
     parser.add_argument("--methods", nargs="+", default=["qdtw", "rtw", "dba"])
     parser.add_argument("--letter", default="G")
-    parser.add_argument("--n-signals", type=int, default=4)
-    parser.add_argument("--scale", type=float, default=0.05, help="c in u = c [x1, x2, x2]")
-    parser.add_argument("--step", type=int, default=1, help="RCFS subsampling (T = 200/step)")
-    parser.add_argument("--lasa-step", type=int, default=10, help="R-LASA subsampling")
+    parser.add_argument("--n-signals", type=positive_int, default=4)
+    parser.add_argument("--scale", type=positive_float, default=0.05,
+                        help="c in u = c [x1, x2, x2]")  # fmt: skip
+    parser.add_argument("--step", type=positive_int, default=1,
+                        help="RCFS subsampling (T = 200/step)")  # fmt: skip
+    parser.add_argument("--lasa-step", type=positive_int, default=10, help="R-LASA subsampling")
     parser.add_argument("--shapes", nargs="*", help="R-LASA shapes (default: all 30)")
-    parser.add_argument("--epochs", type=int, default=256)
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--device", default="cpu")
-    add_engine_options(parser)
-    parser.add_argument("--markdown", help="also write the tables to this Markdown file")
     parser.add_argument("--quick", action="store_true", help="T = 100, 64 epochs, 3 shapes")
-    args = parser.parse_args(argv)
-    apply_engine_options(args)
+    args = parse_paper_args(parser, argv)
     root = data_dir(args.data_dir)
     shapes = args.shapes or rlasa_shapes(root)
     if args.quick:

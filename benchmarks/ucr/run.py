@@ -16,8 +16,14 @@ Examples::
 
 Nothing is downloaded: a dataset must be in --data-dir (aeon's local layout,
 <dir>/<name>/<name>_TRAIN.ts) or bundled with aeon (ArrowHead, GunPoint,
-ItalyPowerDemand). Unavailable datasets are reported and skipped; the exit status is 1
-when no dataset could be run, 0 otherwise.
+ItalyPowerDemand). Unavailable datasets are reported and skipped. Every command-line
+value is checked before any work (a --data-dir that does not exist, an --out that
+cannot be written, --epochs -1, ... exit with a message). The exit status is 1 when no
+dataset could be run, or when every fit of a method failed; 0 otherwise.
+
+On a dask cluster (``--backend dask --scheduler ADDRESS``) the scheduler and workers need
+sk_rtw with its aeon extra installed; the script sends its own code to them and checks
+every node before the first dataset.
 
 Results (``--out``, default ``results/ucr``)::
 
@@ -48,6 +54,16 @@ ROOT = Path(__file__).resolve().parents[2]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
+from benchmarks._shared import (  # noqa: E402
+    check_writable,
+    existing_directory,
+    job_count,
+    non_negative_int,
+    output_length,
+    positive_float,
+    positive_int,
+)
+from benchmarks.ucr._cluster import connect  # noqa: E402
 from benchmarks.ucr._data import (  # noqa: E402
     AEON_BUNDLED,
     ENV_DATA_DIR,
@@ -69,6 +85,8 @@ from benchmarks.ucr._summary import (  # noqa: E402
     scatter_plot,
     verdict,
 )
+from sk_rtw.align import PRESETS  # noqa: E402
+from sk_rtw.align._config import check_device  # noqa: E402
 
 
 def parse_args(argv=None) -> argparse.Namespace:
@@ -79,9 +97,10 @@ def parse_args(argv=None) -> argparse.Namespace:
     )
     parser.add_argument(
         "--data-dir",
+        type=existing_directory,
         default=default_data_dir(),
-        help=f"archive in aeon's local layout (default: ${ENV_DATA_DIR}, else "
-        "aeon's own location with its bundled datasets)",
+        help=f"archive in aeon's local layout, an existing folder (default: ${ENV_DATA_DIR}, "
+        "else aeon's own location with its bundled datasets)",
     )
     which = parser.add_mutually_exclusive_group()
     which.add_argument(
@@ -101,26 +120,36 @@ def parse_args(argv=None) -> argparse.Namespace:
         help="rows to compute (default: all but rtw-paper, which is slow)",
     )
     parser.add_argument(
-        "--epochs", type=int, default=256, help="training epochs of RTW, TTW, NTW (default 256)"
+        "--epochs",
+        type=non_negative_int,
+        default=256,
+        help="training epochs of RTW, TTW, NTW (default 256)",
     )
     parser.add_argument(
         "--max-series-per-class",
-        type=int,
+        type=positive_int,
         default=None,
         help="train on a seeded random subset of at most this many series "
         "per class (the test split is always complete)",
     )
     parser.add_argument(
         "--output-length",
-        type=int,
+        type=output_length,
         default=None,
-        help="length Z of the means (default: min(N, 4) T)",
+        help="length Z of the means of RTW, TTW, NTW (default: the preset's rule, "
+        f"{PRESETS['class-means'].output_length.formula} of each class for the default "
+        "rows; DBA's means keep their medoid's length)",
     )
     parser.add_argument("--device", default="cpu", help="torch device: cpu (default), cuda, ...")
     parser.add_argument(
-        "--seed", type=int, default=0, help="random_state of every method and of subsampling"
+        "--seed",
+        type=non_negative_int,
+        default=0,
+        help="random_state of every method and of subsampling",
     )
-    parser.add_argument("--jobs", type=int, default=1, help="datasets in parallel")
+    parser.add_argument(
+        "--jobs", type=job_count, default=1, help="datasets in parallel (-1: one per core)"
+    )
     parser.add_argument(
         "--backend",
         default="loky",
@@ -131,7 +160,7 @@ def parse_args(argv=None) -> argparse.Namespace:
     )
     parser.add_argument(
         "--time-budget",
-        type=float,
+        type=positive_float,
         default=None,
         help="seconds per dataset; methods not started by then are skipped",
     )
@@ -154,7 +183,20 @@ def parse_args(argv=None) -> argparse.Namespace:
         default=0,
         help="-v: a line per class fit; -vv: epoch progress inside each fit",
     )
-    return parser.parse_args(argv)
+    args = parser.parse_args(argv)
+    if args.backend not in BACKENDS:
+        parser.error(f"argument --backend: {args.backend!r} is not one of {', '.join(BACKENDS)}")
+    if args.scheduler and args.backend != "dask":
+        parser.error("argument --scheduler: only with --backend dask")
+    try:
+        check_device(args.device)
+    except ValueError as exc:
+        parser.error(f"argument --device: {exc}")
+    return args
+
+
+#: joblib backends the script can run datasets on.
+BACKENDS = ("loky", "threading", "multiprocessing", "dask")
 
 
 def select_datasets(args) -> list[str]:
@@ -219,16 +261,7 @@ def run_all(names: list[str], config: RunConfig, jobs: int, backend: str, schedu
         for i, name in enumerate(names)
     ]
     if backend == "dask":
-        from dask.distributed import Client, LocalCluster
-
-        os.environ["PYTHONPATH"] = os.pathsep.join(
-            [str(ROOT), *filter(None, [os.environ.get("PYTHONPATH")])]
-        )
-        client = (
-            Client(scheduler)
-            if scheduler
-            else Client(LocalCluster(n_workers=jobs, threads_per_worker=1))
-        )
+        client = connect(scheduler, jobs)
         print(f"dask: {client}", file=sys.stderr)
         with client, parallel_config(backend="dask"):
             return [advance(r) for r in Parallel(return_as="generator_unordered")(tasks)]
@@ -238,7 +271,7 @@ def run_all(names: list[str], config: RunConfig, jobs: int, backend: str, schedu
 
 def main(argv=None) -> int:
     args = parse_args(argv)
-    out = Path(args.out)
+    out = check_writable(args.out, directory=True)
     names, unavailable = [], []
     for name in select_datasets(args):
         try:
@@ -310,7 +343,29 @@ def main(argv=None) -> int:
     if all(r.get("error") for r in records):
         print("error: every dataset failed (see the result files)", file=sys.stderr)
         return 1
+    failed = [m for m in args.methods if method_failed_everywhere(records, m)]
+    if failed:
+        print(
+            f"error: every fit of {', '.join(failed)} failed (see the result files, e.g. "
+            f"{first_error(records, failed[0])})",
+            file=sys.stderr,
+        )
+        return 1
     return 0
+
+
+def method_failed_everywhere(records: list[dict], method: str) -> bool:
+    """No dataset has a result of ``method``, and at least one has its error."""
+    entries = [r.get("methods", {}).get(method, {}) for r in records if not r.get("error")]
+    return bool(entries) and all("error" in e for e in entries)
+
+
+def first_error(records: list[dict], method: str) -> str:
+    for record in records:
+        entry = record.get("methods", {}).get(method, {})
+        if "error" in entry:
+            return f"{record['dataset']}: {entry['error']}"
+    return ""
 
 
 if __name__ == "__main__":

@@ -367,6 +367,7 @@ def align_collection(
         raise ValueError(f"{len(seeds)} seeds for {layout.n_groups} groups")
     rngs = [np.random.default_rng(int(seed)) for seed in seeds]
     torch_seeds = [int(rng.integers(2**31 - 1)) for rng in rngs]
+    original = collection  # named in error messages
     # magnitudes beyond 1e+-100: align in a frame rescaled by a power of two
     scale = collection.manifold.extreme_scale(collection.data)
     if scale is not None:
@@ -388,7 +389,11 @@ def align_collection(
                 layout,
                 config.output_length,
                 config.dtw_rounds,
-                lambda warps: problem.converged_mean(warps.to(problem.data.device)),
+                lambda warps: _finite(
+                    problem.converged_mean(warps.to(problem.data.device)),
+                    original,
+                    "the DTW start's mean",
+                ),
                 rngs,
                 smoothing=config.smoothing,
                 axis=config.start_axis,
@@ -404,7 +409,7 @@ def align_collection(
             best_epoch, epochs_run = _optimise(problem, model, history, verbose)
         with torch.no_grad():
             _, group_loss, warps, aligned, mean = problem.forward(model)
-            mean = problem.converged_mean(warps, start=mean)
+            mean = _finite(problem.converged_mean(warps, start=mean), original, "the mean")
             costs = group_loss.cpu().numpy()
     factor = 1.0 if scale is None else scale
     manifold = collection.manifold
@@ -428,6 +433,18 @@ def align_collection(
             )
         )
     return results
+
+
+def _finite(values: torch.Tensor, collection: SeriesCollection, what: str) -> torch.Tensor:
+    """``values``, or a ``ValueError`` when float64 could not follow the geometry."""
+    if not bool(torch.isfinite(values).all()):
+        note = collection.manifold.spread_note(collection.data)
+        raise ValueError(
+            f"aligning these series on {collection.manifold!r} left float64 arithmetic "
+            f"(non-finite values in {what})" + (f": {note}" if note else "") + "; the "
+            "geodesics between such points overflow: rescale or regularise the data"
+        )
+    return values
 
 
 def estimated_memory(collection: SeriesCollection, config: AlignmentConfig) -> int:

@@ -454,6 +454,19 @@ class Manifold(ABC):
         """
         return None
 
+    def _beyond_injectivity(self, p: torch.Tensor, v: torch.Tensor) -> torch.Tensor:
+        """Where ``exp(p, v)`` leaves the ball on which ``log`` inverts ``exp`` (over the
+        leading axes): geodesics that long wrap round (a sphere) or stop being shortest."""
+        return self._norm(p, v) > self.injectivity_radius
+
+    def spread_note(self, points: np.ndarray) -> str:
+        """A few words on the range of ``points`` for error messages ("" if none apply).
+
+        :class:`SPD` names the eigenvalue range: where float64 arithmetic cannot follow
+        the geodesics between the points, that range is the reason.
+        """
+        return ""
+
     def continuous(self, series: Any) -> np.ndarray:
         """Representatives of a series that do not jump between equivalent points.
 

@@ -143,6 +143,12 @@ class Product(Manifold):
     def _norm(self, p, v):
         return self._combine("_norm", p, v)
 
+    def _beyond_injectivity(self, p, v):
+        p, v = torch.broadcast_tensors(p, v)
+        parts = zip(self.factors, self._split(p), self._split(v), strict=True)
+        flags = [f._beyond_injectivity(a, b) for f, a, b in parts]
+        return torch.stack(flags).any(0)
+
     def _project(self, x):
         return self._join(
             [f._project(part) for f, part in zip(self.factors, self._split(x), strict=True)],

@@ -102,6 +102,10 @@ class SPD(Manifold):
             return None
         return power_of_two_scale(float(np.exp(np.log(eigenvalues).mean())))
 
+    def spread_note(self, points):
+        values = np.linalg.eigvalsh(np.asarray(points, dtype=np.float64))
+        return f"their eigenvalues run from {values.min():.3g} to {values.max():.3g}"
+
     def _project(self, x):
         w, U = torch.linalg.eigh(sym(x))
         floor = (w.abs().amax(-1, keepdim=True) * 1e-10).clamp_min(1e-12)

@@ -190,6 +190,8 @@ def check_series_collection(
             )
         return X
     _reject_unsupported_containers(X, name)
+    if isinstance(X, np.ndarray) and X.dtype == object and X.ndim == 1:
+        X = list(X)  # np.array(list_of_series, dtype=object): the list it was made from
     if isinstance(X, (list, tuple)) and (len(X) == 0 or not _is_rectangular(X)):
         if len(X) == 0:
             raise ValueError(f"{name} is empty: at least {min_series} series are needed")
