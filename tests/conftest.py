@@ -25,6 +25,9 @@ MANIFOLDS = [
     Product((Euclidean(3), Quaternion())),
 ]
 
+#: The curved ones (log and exp are not subtraction and addition).
+CURVED = [m for m in MANIFOLDS if not m.is_flat]
+
 SHARED = Path(__file__).resolve().parents[1].parent / "shared"
 UCR_DIR = SHARED / "ucr"
 

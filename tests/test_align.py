@@ -23,6 +23,8 @@ from sk_rtw.datasets import make_warped_signals
 from sk_rtw.manifolds import SPD, Euclidean, Quaternion, Sphere
 from sk_rtw.metrics import alignment_quality, barycenter_loss, restoration_accuracy
 
+from .conftest import CURVED, MANIFOLDS
+
 
 @dataclass(frozen=True)
 class CurvedLookingEuclidean(Euclidean):
@@ -55,7 +57,7 @@ def interpolate(manifold, x, warps, window=10, refinements=0):
 
 
 # ------------------------------------------------------------ interpolation
-@pytest.mark.parametrize("manifold", [Euclidean(2), Sphere(2), Quaternion(), SPD(2)], ids=repr)
+@pytest.mark.parametrize("manifold", MANIFOLDS, ids=repr)
 @pytest.mark.parametrize("window", [10, 3, None])
 def test_integer_positions_return_the_samples(manifold, window):
     x = make_warped_signals(manifold, 1, 30, 0).original
@@ -99,12 +101,9 @@ def test_manifold_path_equals_euclidean_special_case(rng):
 # The tangent-point refinement runs without gradient tracking (it is a choice of chart),
 # so the autograd derivative is exact for flat spaces and S^1 and within a fraction of a
 # percent elsewhere (the refinement contracts by ~100x per step).
-@pytest.mark.parametrize(
-    ("manifold", "rtol"),
-    [(Euclidean(2), 1e-7), (Sphere(1), 1e-7), (Sphere(2), 1e-2), (SPD(2), 1e-2)],
-    ids=repr,
-)
-def test_interpolation_gradient_matches_finite_differences(manifold, rtol):
+@pytest.mark.parametrize("manifold", MANIFOLDS, ids=repr)
+def test_interpolation_gradient_matches_finite_differences(manifold):
+    rtol = 1e-7 if manifold.is_flat or manifold == Sphere(1) else 1e-2
     x = torch.as_tensor(make_warped_signals(manifold, 1, 25, 1, amplitude=2.0).original)[None]
     # non-integer positions: at integer ones the windowed kernel has a kink (a tap enters
     # the window with zero weight but non-zero slope), so one-sided derivatives differ
@@ -125,7 +124,7 @@ def test_interpolation_gradient_matches_finite_differences(manifold, rtol):
     assert finite.abs().max() > 0.1  # the test looks at a real slope
 
 
-@pytest.mark.parametrize("manifold", [Sphere(2), SPD(2)], ids=repr)
+@pytest.mark.parametrize("manifold", CURVED, ids=repr)
 def test_interpolated_point_balances_the_weighted_window(manifold):
     """The refined tangent point is the weighted Fréchet mean of the window:
     ``sum_m s_m Log_x(x_m) = 0`` (within the Gauss–Newton tolerance after 2 refinements)."""
@@ -760,7 +759,7 @@ def test_density_mean_from_dtw_runs_is_dbas_update(rng):
     np.testing.assert_allclose(mean, sums / counts[:, None], atol=1e-12)
 
 
-@pytest.mark.parametrize("manifold", [Sphere(2), Quaternion(), SPD(2)], ids=repr)
+@pytest.mark.parametrize("manifold", CURVED, ids=repr)
 def test_density_representatives_on_curved_manifolds(manifold):
     """Curved spaces: a stretch of one sample gives that sample back; a stretch of many
     gives the tangent-space average at the aligned point (an independent loop here), on

@@ -27,7 +27,7 @@ from sk_rtw.baselines import dba_average, mmddtw_align
 from sk_rtw.datasets import make_warped_signals
 from sk_rtw.utils import from_aeon, from_tslearn, to_aeon
 
-from .conftest import quick
+from .conftest import MANIFOLDS, quick
 
 RNG = np.random.default_rng(0)
 UNI = RNG.standard_normal((6, 20))  # 6 univariate series
@@ -405,7 +405,7 @@ def test_valid_input_gives_the_right_answer(check):
     check()
 
 
-@pytest.mark.parametrize("manifold", [Euclidean(2), Sphere(2), SPD(2), Quaternion()], ids=repr)
+@pytest.mark.parametrize("manifold", MANIFOLDS, ids=repr)
 def test_a_mean_of_zero_samples_says_so(manifold):
     import torch
 

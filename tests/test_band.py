@@ -7,7 +7,9 @@ import pytest
 
 from sk_rtw.dtw import path_indices
 from sk_rtw.dtw._band import band_from_path, halve, multiscale_path
-from sk_rtw.manifolds import SPD, Euclidean, Product, Quaternion, Sphere
+from sk_rtw.manifolds import SPD, Euclidean, Sphere
+
+from .conftest import MANIFOLDS
 
 
 def smooth_walk(rng, n, dim):
@@ -15,12 +17,10 @@ def smooth_walk(rng, n, dim):
     return np.cumsum(np.cumsum(steps, 0), 0) / n
 
 
-@pytest.mark.parametrize(
-    "manifold", [Euclidean(2), Sphere(2), Product((Euclidean(3), Quaternion())), SPD(2)], ids=repr
-)
+@pytest.mark.parametrize("manifold", MANIFOLDS, ids=repr)
 def test_multiscale_path_matches_the_exact_path_on_smooth_series(manifold, rng):
     base = rng.standard_normal(manifold.point_shape)
-    p = manifold.project(base) if not isinstance(manifold, SPD) else np.eye(2)
+    p = manifold.project(base) if not isinstance(manifold, SPD) else np.eye(manifold.dim)
     t = np.linspace(0, 1, 900)
     tangent = manifold.random_tangent(p, 1.0, random_state=1)
 

@@ -11,7 +11,9 @@ from aeon.distances import dtw_distance as aeon_dtw_distance
 from aeon.distances import dtw_pairwise_distance as aeon_dtw_pairwise_distance
 
 from sk_rtw.dtw import dtw_cost_matrix, dtw_distance, dtw_pairwise_distance, dtw_path
-from sk_rtw.manifolds import SPD, Product, Quaternion, Sphere, get_manifold
+from sk_rtw.manifolds import SPD, Product, Quaternion, Sphere
+
+from .conftest import MANIFOLDS
 
 
 def reference_dtw(x, y, manifold, squared=False, band=None):
@@ -87,9 +89,7 @@ def aeon_band(nx, ny, window):
     return create_bounding_matrix(nx, ny, window=window)
 
 
-@pytest.mark.parametrize(
-    "manifold", [Sphere(1), Sphere(2), Quaternion(), SPD(2), get_manifold("pose")], ids=repr
-)
+@pytest.mark.parametrize("manifold", MANIFOLDS, ids=repr)
 @pytest.mark.parametrize("squared", [False, True])
 def test_matches_python_reference_on_manifolds(manifold, squared):
     x, y = random_walk(manifold, 14, 1), random_walk(manifold, 11, 2)
@@ -102,9 +102,7 @@ def test_matches_python_reference_on_manifolds(manifold, squared):
     )
 
 
-@pytest.mark.parametrize(
-    "manifold", [Sphere(2), Quaternion(), SPD(2), get_manifold("pose")], ids=repr
-)
+@pytest.mark.parametrize("manifold", MANIFOLDS, ids=repr)
 def test_pairwise_matches_single_distances_on_manifolds(manifold):
     X = [random_walk(manifold, n, 10 + n) for n in (9, 12, 7)]
     Y = [random_walk(manifold, n, 20 + n) for n in (10, 8)]

@@ -157,18 +157,7 @@ def _t(x):
     return torch.tensor(np.asarray(x), dtype=torch.float64, requires_grad=True)
 
 
-@pytest.mark.parametrize(
-    "M",
-    [
-        Sphere(1),
-        Sphere(2),
-        Quaternion(),
-        SPD(2),
-        Euclidean(2),
-        Product((Euclidean(3), Quaternion())),
-    ],
-    ids=manifold_id,
-)
+@parametrize_manifolds
 def test_gradcheck_at_zero_tangent_and_coincident_points(M):
     p = M.random_point((), 23)
     zero = np.zeros(M.point_shape)
@@ -182,7 +171,7 @@ def test_gradcheck_at_zero_tangent_and_coincident_points(M):
     assert torch.isfinite(x.grad).all()
 
 
-@pytest.mark.parametrize("M", [Sphere(1), Sphere(2), Sphere(4)], ids=manifold_id)
+@pytest.mark.parametrize("M", [m for m in MANIFOLDS if type(m) is Sphere], ids=manifold_id)
 def test_gradcheck_near_antipodes(M):
     p = M.random_point((), 24)
     tangent = M.random_tangent(p, 1.0, 25)

@@ -12,6 +12,8 @@ from sk_rtw.align._sinc_kernel import window_sums_parallel, window_sums_serial
 from sk_rtw.datasets import make_warped_signals
 from sk_rtw.manifolds import SPD, Euclidean, Product, Quaternion, Sphere
 
+from .conftest import MANIFOLDS
+
 SPACES = [
     Euclidean(1),
     Euclidean(3),
@@ -83,7 +85,7 @@ def test_parallel_kernel_equals_the_serial_one():
     np.testing.assert_array_equal(outputs[0][1], outputs[1][1])
 
 
-@pytest.mark.parametrize("manifold", [Euclidean(2), Sphere(2), SPD(2)], ids=repr)
+@pytest.mark.parametrize("manifold", MANIFOLDS, ids=repr)
 @pytest.mark.parametrize("window", [10, None])
 def test_chunks_and_table_budget_do_not_change_the_result(manifold, window, monkeypatch):
     data, lengths, warps = collection(manifold)
@@ -101,7 +103,7 @@ def test_chunks_and_table_budget_do_not_change_the_result(manifold, window, monk
     np.testing.assert_allclose(u.numpy(), reference[0].numpy(), atol=1e-12)
 
 
-@pytest.mark.parametrize("manifold", [Euclidean(2), Sphere(1), Sphere(2), SPD(2)], ids=repr)
+@pytest.mark.parametrize("manifold", MANIFOLDS, ids=repr)
 @pytest.mark.parametrize("window", [10, None])
 def test_gradient_without_refinement_matches_finite_differences(manifold, window):
     """Without refinement the chart is fixed per window: the derivative is exact."""

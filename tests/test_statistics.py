@@ -11,7 +11,7 @@ from sk_rtw import SPD, Euclidean, Product, Quaternion, Sphere, align, aligned_s
 from sk_rtw.baselines import dba_average
 from sk_rtw.datasets import make_warped_signals
 
-from .conftest import MANIFOLDS, manifold_id
+from .conftest import CURVED, MANIFOLDS, manifold_id
 
 
 # ---------------------------------------------------------- tangent coordinates
@@ -64,11 +64,7 @@ def test_flat_statistics_are_the_ordinary_covariance(rng):
     assert stats.variance.shape == (20,)
 
 
-@pytest.mark.parametrize(
-    "manifold",
-    [Sphere(2), Quaternion(), SPD(2), Product((Euclidean(3), Quaternion()))],
-    ids=manifold_id,
-)
+@pytest.mark.parametrize("manifold", CURVED, ids=manifold_id)
 def test_curved_statistics_are_the_covariance_of_logs_at_the_mean(manifold):
     data = make_warped_signals(manifold, 6, 30, 0, amplitude=0.8)
     result = align(data.signals, manifold=manifold, n_epochs=3, random_state=0)

@@ -49,24 +49,31 @@ from ._data import load_split, subsample_per_class, take
 ALPHA = 0.05
 #: Result files are readable by everyone (rw-r--r--), like any file the user writes.
 FILE_MODE = 0o644
-#: Rows computed by the product's estimator: the method, its settings, the preset.
-ESTIMATOR_METHODS: dict[str, tuple[str, dict, str]] = {
-    "rtw": ("rtw", {}, "class-means"),
-    "rtw-paper": ("rtw", {}, "paper"),
+#: Rows computed by the product's estimator: the method, its settings, the preset, and
+#: other estimator parameters.
+TUNED = {"n_centroids": "auto", "dtw_window": "auto"}
+ESTIMATOR_METHODS: dict[str, tuple[str, dict, str, dict]] = {
+    "rtw": ("rtw", {}, "class-means", {}),
+    "rtw-paper": ("rtw", {}, "paper", {}),
     # ablations of the class-means preset: the paper's equal-weight mean, and align's
     # defaults (equal weights on the average time axis, 3 start rounds, Z = min(N, 4) T)
-    "rtw-equal": ("rtw", {"mean_weights": "equal"}, "class-means"),
-    "rtw-alignment": ("rtw", {}, "alignment"),
-    "ttw": ("ttw", {}, "class-means"),
-    "ntw": ("ntw", {}, "class-means"),
-    "dba": ("dba", {}, "class-means"),
+    "rtw-equal": ("rtw", {"mean_weights": "equal"}, "class-means", {}),
+    "rtw-alignment": ("rtw", {}, "alignment", {}),
+    "ttw": ("ttw", {}, "class-means", {}),
+    "ntw": ("ntw", {}, "class-means", {}),
+    "dba": ("dba", {}, "class-means", {}),
+    # the tuned classifier in one line: window and centroids chosen from the training set
+    "rtw-tuned": ("rtw", {}, "class-means", TUNED),
+    "dba-tuned": ("dba", {}, "class-means", TUNED),
 }
 REFERENCE_METHODS = ("aeon-dba", "1nn-dtw")
 ALL_METHODS = (*ESTIMATOR_METHODS, *REFERENCE_METHODS)
 #: The default rows (``rtw-paper`` is slow: means of length N T with the network at every
-#: time point; the ablations on demand; ask for them with ``--methods``).
+#: time point; the ablations and the tuned rows on demand; ask for them with ``--methods``).
 DEFAULT_METHODS = tuple(
-    m for m in ALL_METHODS if m not in ("rtw-paper", "rtw-equal", "rtw-alignment")
+    m
+    for m in ALL_METHODS
+    if m not in ("rtw-paper", "rtw-equal", "rtw-alignment", "rtw-tuned", "dba-tuned")
 )
 
 
@@ -107,7 +114,7 @@ def _class_members(y, classes):
 
 def make_estimator(row: str, config: RunConfig) -> RTWNearestCentroid:
     """The estimator of one row, with the run's epochs, output length, seed and device."""
-    name, settings, preset = ESTIMATOR_METHODS[row]
+    name, settings, preset, params = ESTIMATOR_METHODS[row]
     lengths = {} if config.output_length is None else {"output_length": config.output_length}
     method = method_object(name, **settings, n_epochs=config.epochs, **lengths)
     return RTWNearestCentroid(
@@ -116,6 +123,7 @@ def make_estimator(row: str, config: RunConfig) -> RTWNearestCentroid:
         random_state=config.seed,
         device=config.device,
         verbose=max(0, config.verbose - 1),  # 2: a line per class, 3: epoch progress
+        **params,
     )
 
 
@@ -126,10 +134,10 @@ def _fit_estimator(method, train, test, config):
     fit_seconds = time.perf_counter() - start
     alignment = np.full(len(train.y), np.nan)
     barycenter = np.full(len(train.y), np.nan)
-    for k, members in enumerate(_class_members(train.y, estimator.classes_)):
-        mean = estimator.means_[k][None]
-        aligned = estimator.alignments_[k].aligned
-        alignment[members] = dtw_pairwise_distance(aligned, mean)[:, 0]
+    for k, fitted in enumerate(estimator.alignments_):  # every centroid and its series
+        members = np.flatnonzero(estimator.assignments_ == k)
+        mean = np.asarray(estimator.means_[k])[None]
+        alignment[members] = dtw_pairwise_distance(fitted.aligned, mean)[:, 0]
         series = (
             train.X[members] if isinstance(train.X, np.ndarray) else [train.X[i] for i in members]
         )
@@ -148,6 +156,8 @@ def _fit_estimator(method, train, test, config):
         "best_epochs": [
             a.best_epoch if isinstance(a, Alignment) else -1 for a in estimator.alignments_
         ],
+        "dtw_window": estimator.dtw_window_,
+        "n_centroids": estimator.n_centroids_,
         "iterations": [a.n_iter for a in estimator.alignments_],
         "output_length": [len(m) for m in estimator.means_],
     }

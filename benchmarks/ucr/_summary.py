@@ -127,7 +127,79 @@ def verdict(records: list[dict], methods: list[str]) -> list[str]:
     return lines
 
 
-def markdown(records: list[dict], methods: list[str], command: str, machine: str) -> str:
+def split_halves(names: list[str]) -> tuple[list[str], list[str]]:
+    """The two fixed halves of a set of datasets: alphabetical positions 1, 3, 5, ...
+    (half A, where defaults are chosen) and 2, 4, 6, ... (half B, where they are confirmed)."""
+    ordered = sorted(names)
+    return ordered[0::2], ordered[1::2]
+
+
+def barycenter_cost(record: dict, method: str) -> float | None:
+    """Total DTW of the training series to their class means (the averaging measure)."""
+    values = np.asarray(record["methods"].get(method, {}).get("barycenter", []), dtype=float)
+    return float(values.sum()) if len(values) and np.isfinite(values).all() else None
+
+
+def halves_markdown(records: list[dict], methods: list[str]) -> list[str]:
+    """Per half and over all: mean accuracy, and every method against the others."""
+    done = [r for r in records if not r.get("error")]
+    half_a, half_b = split_halves([r["dataset"] for r in done])
+    parts = {"half A (odd)": half_a, "half B (even)": half_b, "all": half_a + half_b}
+    lines = [
+        "## Halves",
+        "",
+        "Half A: alphabetical positions 1, 3, 5, ... (" + ", ".join(half_a) + "); half B: "
+        "2, 4, 6, ... (" + ", ".join(half_b) + "). Defaults are chosen on half A and "
+        "confirmed on half B.",
+        "",
+        "| method | " + " | ".join(f"mean accuracy, {p}" for p in parts) + " |",
+        "| --- | " + " | ".join("---" for _ in parts) + " |",
+    ]
+    for m in methods:
+        cells = []
+        for names in parts.values():
+            _, acc = accuracy_matrix([r for r in done if r["dataset"] in names], [m])
+            cells.append(f"{acc[:, 0].mean():.4f} (n={len(acc)})" if len(acc) else "-")
+        lines.append(f"| {m} | " + " | ".join(cells) + " |")
+    lines += [
+        "",
+        "Pairs: datasets where the first method is at least as accurate as the second, and "
+        "where its class means have a total DTW cost no higher (averaging measure).",
+        "",
+        "| first | second | "
+        + " | ".join(f"at least as accurate, {p}" for p in parts)
+        + " | lower or equal DTW cost, all |",
+        "| --- | --- | " + " | ".join("---" for _ in parts) + " | --- |",
+    ]
+    for a, b in HALF_PAIRS:
+        if a not in methods or b not in methods:
+            continue
+        cells = []
+        for names in parts.values():
+            row = wins_ties_losses([r for r in done if r["dataset"] in names], a, b)
+            cells.append(f"{row['wins'] + row['ties']} / {row['n']}" if row["n"] else "-")
+        costs = [(barycenter_cost(r, a), barycenter_cost(r, b)) for r in done]
+        costs = [(x, y) for x, y in costs if x is not None and y is not None]
+        cost_cell = f"{sum(x <= y for x, y in costs)} / {len(costs)}" if costs else "-"
+        lines.append(f"| {a} | {b} | " + " | ".join(cells) + f" | {cost_cell} |")
+    return [*lines, ""]
+
+
+#: The comparisons of the halves report (first method against second).
+HALF_PAIRS = (
+    ("rtw", "dba"),
+    ("rtw-tuned", "dba-tuned"),
+    ("rtw-tuned", "1nn-dtw"),
+    ("dba-tuned", "1nn-dtw"),
+    ("rtw", "1nn-dtw"),
+    ("rtw", "ttw"),
+    ("rtw", "ntw"),
+)
+
+
+def markdown(
+    records: list[dict], methods: list[str], command: str, machine: str, halves: bool = False
+) -> str:
     lines = [
         "# UCR benchmark: RTW vs TTW vs NTW vs DBA (and aeon's DBA, 1-NN DTW references)",
         "",
@@ -138,6 +210,8 @@ def markdown(records: list[dict], methods: list[str], command: str, machine: str
     failed = [r for r in records if r.get("error")]
     lines += [f"Datasets: {len(records)} ({len(failed)} failed).", ""]
     lines += ["## Verdict", "", *(f"{v}  " for v in verdict(records, methods)), ""]
+    if halves:
+        lines += halves_markdown(records, methods)
     names, acc = accuracy_matrix(records, methods)
     if len(names):
         ranks = np.mean([rankdata(-row) for row in acc], axis=0)

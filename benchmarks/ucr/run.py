@@ -168,6 +168,12 @@ def parse_args(argv=None) -> argparse.Namespace:
         "--out", default="results/ucr", help="results directory (default results/ucr)"
     )
     parser.add_argument(
+        "--halves",
+        action="store_true",
+        help="also report the two fixed halves of the datasets (alphabetical odd / even "
+        "positions): where defaults are chosen, and where they are confirmed",
+    )
+    parser.add_argument(
         "--resume",
         action="store_true",
         help="skip datasets whose result file in --out exists without an error",
@@ -321,7 +327,7 @@ def main(argv=None) -> int:
         f"{platform.python_version()}, device {args.device}; "
         f"{time.perf_counter() - start:.0f} s for {len(todo)} dataset(s)"
     )
-    text = markdown(records, list(args.methods), command.strip(), machine)
+    text = markdown(records, list(args.methods), command.strip(), machine, halves=args.halves)
     (out / "summary.md").write_text(text)
     written = [out / "summary.md"]
     if scatter_plot(records, out / "accuracy_scatter.png"):

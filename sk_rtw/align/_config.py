@@ -13,12 +13,12 @@ everywhere. The tables of the docs are rendered from the same records
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, fields
 from typing import Any
 
 import torch
 
-from ..utils._params import AUTO, InstanceOf, Options, Parameter, Satisfies
+from ..utils._params import AUTO, InstanceOf, Options, Parameter
 from ._knobs import ENGINE_METHODS, KNOBS, METHODS, method_knobs, owners
 from ._presets import PRESETS
 
@@ -34,7 +34,8 @@ class AlignmentConfig:
     (``hidden_size``, ``init`` and ``warp_knots`` for TTW's sine warps, ``n_components``
     for the networks of RTW and NTW) are None. ``output_length`` is ``Z``, the length of
     ``Alignment.mean`` (shape ``(Z, *point_shape)``) and of every aligned series;
-    ``warp_start`` is ``"given"`` when starting warps were passed as an array. See
+    ``warp_start`` is ``"given"`` when starting warps were passed as an array;
+    ``dtw_window`` is the Sakoe-Chiba band of the DTW start (None: none). See
     :func:`sk_rtw.align` and the knobs table of the user guide for each field.
     """
 
@@ -64,6 +65,7 @@ class AlignmentConfig:
     tol: float
     device: str
     cuda_graph: bool = False
+    dtw_window: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """The configuration as a plain dictionary (field name to value).
@@ -118,16 +120,18 @@ PRESET_PARAMETER = Parameter(
     (Options(tuple(PRESETS)),),
     "Named configuration of the averaging method, resolved before explicit settings: "
     + "; ".join(f'"{p.name}": {p.summary}' for p in PRESETS.values())
-    + " (the presets table of the user guide lists every value).",
+    + ". The presets table of the user guide lists every value.",
 )
 DEVICE_PARAMETER = Parameter(
     "device",
-    (InstanceOf((str, torch.device), "str or torch.device", "a torch device", _device),),
+    (
+        InstanceOf(
+            "str or torch.device", "a torch device", types=(str, torch.device), normaliser=_device
+        ),
+    ),
     'Torch device of the engine\'s optimisation (RTW, TTW, NTW), e.g. "cuda"; results '
     "are numpy arrays. DBA and the DTW computations run on the CPU.",
 )
-#: ``warp_start`` of :func:`sk_rtw.align` also takes starting warps as an array.
-GIVEN_WARPS = Satisfies(lambda v: not isinstance(v, str), "array of shape (N, Z)", "an array")
 
 
 def knob_parameter(name: str) -> Parameter:
@@ -181,6 +185,7 @@ def resolve_config(
     *,
     device: str = "cpu",
     given_start: bool = False,
+    dtw_window: float | None = None,
 ) -> AlignmentConfig:
     """The engine configuration of ``method`` for series of these ``lengths``.
 
@@ -197,6 +202,8 @@ def resolve_config(
         A checked device.
     given_start : bool, default=False
         Starting warps were passed as an array.
+    dtw_window : float or None, default=None
+        A checked Sakoe-Chiba band of the DTW start.
 
     Returns
     -------
@@ -205,35 +212,22 @@ def resolve_config(
     values = resolve_knobs(method, preset, explicit)
     if values["output_length"] is None:
         values["output_length"] = PRESETS[preset].output_length(lengths)
-    neural = method in ("rtw", "ntw")
+    if given_start:
+        values["warp_start"] = "given"
+    # the knobs; those of other methods (TTW's network, RTW's sine terms) are None
+    knobs: dict[str, Any] = {name: values.get(name) for name in _KNOB_FIELDS}
     return AlignmentConfig(
         method=method,
         preset=preset,
-        warp="neural" if neural else "sine",
-        init=values.get("init"),
-        warp_start="given" if given_start else values["warp_start"],
-        dtw_rounds=values["dtw_rounds"],
-        output_length=values["output_length"],
-        n_epochs=values["n_epochs"],
-        learning_rate=values["learning_rate"],
-        sinc_window=values["sinc_window"],
-        loss_window=values["loss_window"],
-        loss_step=values["loss_step"],
-        penalty=values["penalty"],
-        n_components=values.get("n_components"),
-        hidden_size=values.get("hidden_size"),
-        warp_knots=values.get("warp_knots"),
-        tangent_refinements=values["tangent_refinements"],
-        mean_iterations=values["mean_iterations"],
-        mean_start=values["mean_start"],
-        mean_weights=values["mean_weights"],
-        smoothing=values["smoothing"],
-        start_axis=values["start_axis"],
-        n_iter_no_change=values["n_iter_no_change"],
-        tol=values["tol"],
+        warp="neural" if method in ("rtw", "ntw") else "sine",
         device=device,
-        cuda_graph=values["cuda_graph"],
+        dtw_window=dtw_window,
+        **knobs,
     )
+
+
+#: The fields of :class:`AlignmentConfig` that hold a knob's value.
+_KNOB_FIELDS = tuple(f.name for f in fields(AlignmentConfig) if f.name in KNOBS)
 
 
 # ------------------------------------------------------------------ docs tables

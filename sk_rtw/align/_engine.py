@@ -24,7 +24,7 @@ from .._threads import limited_threads, threads_for
 from ..manifolds import Manifold
 from ..manifolds._mean import frechet_mean
 from ..utils import SeriesCollection, check_series_collection
-from ..utils._common_params import MANIFOLD, N_JOBS, RANDOM_STATE, VERBOSE
+from ..utils._common_params import DTW_WINDOW, MANIFOLD, N_JOBS, RANDOM_STATE, VERBOSE
 from ..utils._params import AUTO, Declaration, Options, Parameter, Satisfies
 from ._config import (
     DEVICE_PARAMETER,
@@ -195,11 +195,17 @@ ALIGN_VERBOSE = Parameter(
     "Print the loss every max(1, n_epochs // 10) epochs (True or 1), or every verbose "
     "epochs (an int > 1).",
 )
+ALIGN_WINDOW = Parameter(
+    "dtw_window",
+    DTW_WINDOW.constraints,
+    "Sakoe-Chiba band of the DTW start (its medoid and paths), its radius as a fraction "
+    "of the shorter series' length; None: no band.",
+)
 ALIGN_METHOD = Parameter(
     "method",
     (
         Options(ENGINE_METHODS),
-        Satisfies(_is_engine_method, "RTW, TTW or NTW", "RTW(), TTW() or NTW()"),
+        Satisfies("RTW, TTW or NTW", "RTW(), TTW() or NTW()", predicate=_is_engine_method),
     ),
     'The method: "rtw" (neural warps, windowed sinc, Gaussian window loss, monotonicity '
     'penalty), "ntw" (neural warps with zero init, full sinc, pointwise loss) or "ttw" '
@@ -214,6 +220,7 @@ def align(
     manifold: str | Manifold = "euclidean",
     method: Any = "rtw",
     preset: str = "alignment",
+    dtw_window: float | None = None,
     random_state: Any = None,
     device: str | torch.device = "cpu",
     n_jobs: int | None = None,
@@ -266,6 +273,7 @@ def align(
         settings = {**method.settings(), **settings}
         method = method.name
     preset = check_preset(preset)
+    window = ALIGN_WINDOW.check(dtw_window)
     device_name = DEVICE_PARAMETER.check(device)
     RANDOM_STATE.check(random_state)
     N_JOBS.check(n_jobs)
@@ -281,7 +289,7 @@ def align(
         given_start = _check_warps(given, n_signals, explicit.get("output_length"))
         explicit["output_length"] = given_start.shape[1]
     config = resolve_config(method, preset, explicit, collection.lengths, device=device_name,
-                            given_start=given_start is not None)  # fmt: skip
+                            given_start=given_start is not None, dtw_window=window)  # fmt: skip
     seed = int(check_generator(random_state).integers(2**31 - 1))
     (result,) = align_collection(
         collection, np.zeros(n_signals, dtype=np.int64), [seed], config,
@@ -293,10 +301,10 @@ def align(
 def _align_docs() -> None:
     """``align``'s signature and "Parameters" from the declarations (knobs included)."""
     own = Declaration(
-        (MANIFOLD, ALIGN_METHOD, PRESET_PARAMETER, RANDOM_STATE, DEVICE_PARAMETER, N_JOBS,
-         ALIGN_VERBOSE),
-        {"manifold": "euclidean", "method": "rtw", "preset": "alignment", "random_state": None,
-         "device": "cpu", "n_jobs": None, "verbose": False},
+        (MANIFOLD, ALIGN_METHOD, PRESET_PARAMETER, ALIGN_WINDOW, RANDOM_STATE,
+         DEVICE_PARAMETER, N_JOBS, ALIGN_VERBOSE),
+        {"manifold": "euclidean", "method": "rtw", "preset": "alignment", "dtw_window": None,
+         "random_state": None, "device": "cpu", "n_jobs": None, "verbose": False},
     )  # fmt: skip
     knobs = [KNOBS[name] for name in KNOBS if set(KNOBS[name].methods) & set(ENGINE_METHODS)]
     listing = ", ".join(f"``{k.name}``" for k in knobs)
@@ -397,6 +405,7 @@ def align_collection(
                 rngs,
                 smoothing=config.smoothing,
                 axis=config.start_axis,
+                window=config.dtw_window,
             )
         if given_start is not None:
             problem.start = torch.as_tensor(given_start, dtype=torch.float64, device=config.device)

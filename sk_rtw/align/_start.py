@@ -33,7 +33,7 @@ from collections.abc import Callable
 import numpy as np
 import torch
 
-from ..dtw import medoid_index
+from ..dtw import check_window, medoid_index, path_indices
 from ..dtw._band import halve, multiscale_path
 from ..manifolds import Manifold
 from ..utils import SeriesCollection
@@ -138,7 +138,10 @@ def coarse(series: np.ndarray, manifold: Manifold, length: int) -> np.ndarray:
 
 
 def reference_medoid(
-    series: list[np.ndarray], manifold: Manifold, rng: np.random.Generator
+    series: list[np.ndarray],
+    manifold: Manifold,
+    rng: np.random.Generator,
+    window: float | None = None,
 ) -> np.ndarray:
     """The first reference: the DTW medoid of (at most :data:`MEDOID_CANDIDATES`) series.
 
@@ -162,7 +165,7 @@ def reference_medoid(
         [np.concatenate([s, np.repeat(s[-1:], lengths.max() - len(s), 0)]) for s in small]
     )
     collection = SeriesCollection(data=data, lengths=lengths, manifold=manifold)
-    return series[int(index[medoid_index(collection)])]
+    return series[int(index[medoid_index(collection, window=window)])]
 
 
 #: DTW cells of the all-pairs medoid search beyond which the series are halved first.
@@ -178,6 +181,7 @@ def dtw_start(
     rngs: list[np.random.Generator],
     smoothing: float | None = None,
     axis: str = "average",
+    window: float | None = None,
 ) -> np.ndarray:
     """Starting warps ``(N, n_points)`` from DTW paths (see the module docstring).
 
@@ -201,6 +205,9 @@ def dtw_start(
         :data:`SMOOTHING`).
     axis : {"average", "reference"}, default="average"
         Time axis of the returned warps (:data:`START_AXES`).
+    window : float in [0, 1] or None
+        Sakoe-Chiba band of the medoid search and of the paths (None: no band; long
+        pairs are then solved coarse to fine).
 
     Returns
     -------
@@ -209,11 +216,12 @@ def dtw_start(
     if axis not in START_AXES:
         raise ValueError(f"axis must be one of {START_AXES}, got {axis!r}")
     on_axis = centred_warps if axis == "average" else reference_warps
+    band = check_window(window)
     manifold = collection.manifold
     series = [collection.series(i) for i in range(collection.n_series)]
     members = [layout.members(g) for g in range(layout.n_groups)]
     references = [
-        reference_medoid([series[i] for i in idx], manifold, rng)
+        reference_medoid([series[i] for i in idx], manifold, rng, window)
         for idx, rng in zip(members, rngs, strict=True)
     ]
     # later references: the group mean at the output length
@@ -224,7 +232,10 @@ def dtw_start(
         previous = list(along)
         for i, s in enumerate(series):
             reference = references[codes[i]]
-            path, _ = multiscale_path(reference, s, manifold, squared=True)
+            if window is None:
+                path, _ = multiscale_path(reference, s, manifold, squared=True)
+            else:
+                path, _ = path_indices(reference, s, manifold, band, squared=True)
             along[i] = path_warp(path, len(reference), len(s), smoothing)
         if round_ == rounds - 1 or (
             round_ > 1 and all(np.array_equal(a, b) for a, b in zip(along, previous, strict=True))

@@ -16,6 +16,7 @@ from ..utils import check_series_collection
 from ..utils._params import declare_parameters, validate_parameters
 from ._core import fit_centroids, kmeans
 from ._params import AVERAGER_DEFAULTS, AVERAGER_PARAMETERS, setting_hint
+from ._selection import CENTROIDS, cv_accuracy, folds, loo_window
 
 
 @declare_parameters(AVERAGER_PARAMETERS, AVERAGER_DEFAULTS, hint=setting_hint)
@@ -59,6 +60,13 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         The averaging method used.
     manifold_ : Manifold
         The manifold resolved against the training data.
+    dtw_window_ : float or None
+        The Sakoe-Chiba band used in the fit and by ``transform`` (``dtw_window``, or
+        the one chosen for ``"auto"``).
+    n_centroids_ : int
+        Centroids per class (``n_centroids``, or the number chosen for ``"auto"``).
+    selection_ : dict
+        The training-data scores behind the ``"auto"`` choices (empty without them).
     n_features_in_ : int
         Length of the training series when they all have the same length (a
         scikit-learn convention; series of any length are accepted by ``transform``).
@@ -95,14 +103,10 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         return self
 
     def _fit_means(self, X, y, require_two_classes):
-        """Validate every parameter, then fit ``n_centroids`` means per class."""
+        """Validate every parameter, resolve the "auto" choices, fit the means."""
         params = validate_parameters(self)
         method = get_method(params["method"])
         method.settings()  # every setting of the method checked before any work
-        context = FitContext(
-            preset=params["preset"], dtw_window=params["dtw_window"], device=params["device"],
-            n_jobs=params["n_jobs"], verbose=int(params["verbose"]),
-        )  # fmt: skip
         collection = check_series_collection(X, self.manifold)
         if y is None:
             labels = np.zeros(collection.n_series, dtype=int)
@@ -114,10 +118,17 @@ class RTWAverager(TransformerMixin, BaseEstimator):
                 f"{type(self).__name__} needs at least 2 classes in y; got {len(classes)} "
                 f"class ({classes.tolist()})"
             )
+        window, n_centroids = params["dtw_window"], params["n_centroids"]
+        self.selection_ = {}
+        if "auto" in (window, n_centroids):
+            window, n_centroids = self._select(collection, codes, window, n_centroids)
+        context = FitContext(
+            preset=params["preset"], dtw_window=window, device=params["device"],
+            n_jobs=params["n_jobs"], verbose=int(params["verbose"]),
+        )  # fmt: skip
         sizes = np.bincount(codes)
         seeds = check_random_state(self.random_state).randint(2**31 - 1, size=len(classes))
         owner = type(self).__name__
-        n_centroids = params["n_centroids"]
         if n_centroids == 1:
             fits = fit_centroids(method, collection, codes, [int(s) for s in seeds], context,
                                  names=list(classes), kind="class", owner=owner)  # fmt: skip
@@ -137,6 +148,8 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         self.classes_ = classes
         self.method_ = method.name
         self.manifold_ = collection.manifold
+        self.dtw_window_ = window
+        self.n_centroids_ = n_centroids
         self.alignments_ = fits
         self.centroid_classes_ = centroid_classes
         self.assignments_ = assignments
@@ -146,6 +159,37 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         if collection.equal_length and collection.manifold.point_shape == (1,):
             self.n_features_in_ = collection.max_length
         return self
+
+    def _select(self, collection, codes, window, n_centroids):
+        """Resolve ``dtw_window="auto"`` and ``n_centroids="auto"`` (see
+        :mod:`sk_rtw.estimators._selection`); the scores go to ``selection_``."""
+        if len(np.unique(codes)) < 2:
+            raise ValueError(
+                '"auto" choices are made by classifying the training series: they need y '
+                "with at least 2 classes"
+            )
+        if window == "auto":
+            window, scores = loo_window(collection, codes, n_jobs=self.n_jobs)
+            self.selection_["dtw_window"] = scores
+        if n_centroids == "auto":
+            splits = folds(codes, self.random_state)
+            largest = max(1, min(int(np.bincount(codes).min()), max(CENTROIDS)))
+            candidates = [k for k in CENTROIDS if k <= largest] or [1]
+            scores = {
+                k: cv_accuracy(self, collection, codes, splits, dtw_window=window, n_centroids=k)
+                for k in candidates
+            } if splits and len(candidates) > 1 else {1: float("nan")}  # fmt: skip
+            n_centroids = max(scores, key=lambda k: (scores[k], -k))
+            self.selection_["n_centroids"] = scores
+        return window, n_centroids
+
+    def _centroid_distances(self, X: Any) -> np.ndarray:
+        """Manifold-DTW distance of every series to every entry of ``means_``."""
+        check_is_fitted(self, "means_")
+        collection = check_series_collection(X, self.manifold_, min_length=1)
+        means = check_series_collection(self.means_, self.manifold_, name="means_")
+        return dtw_pairwise_distance(collection, means, window=self.dtw_window_,
+                                     n_jobs=self.n_jobs)  # fmt: skip
 
     # ------------------------------------------------------------ transform
     def transform(self, X: Any) -> np.ndarray:
@@ -163,10 +207,7 @@ class RTWAverager(TransformerMixin, BaseEstimator):
             ``n_centroids x n_classes`` with ``n_centroids > 1``; ``centroid_classes_``
             gives the class of each column).
         """
-        check_is_fitted(self, "means_")
-        collection = check_series_collection(X, self.manifold_, min_length=1)
-        means = check_series_collection(self.means_, self.manifold_, name="means_")
-        return dtw_pairwise_distance(collection, means, window=self.dtw_window, n_jobs=self.n_jobs)
+        return self._centroid_distances(X)
 
     def __sklearn_tags__(self):
         tags = super().__sklearn_tags__()

@@ -91,6 +91,12 @@ class RTWNearestCentroid(ClassifierMixin, RTWAverager):
         Entry of ``means_`` each training series was averaged into.
     method_ : str
     manifold_ : Manifold
+    dtw_window_ : float or None
+        The Sakoe-Chiba band of the fit and of prediction (chosen for ``"auto"``).
+    n_centroids_ : int
+        Centroids per class (chosen for ``"auto"``).
+    selection_ : dict
+        The training-data scores behind the ``"auto"`` choices.
     temperature_ : float
         The temperature used by :meth:`predict_proba`.
 

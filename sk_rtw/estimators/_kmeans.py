@@ -12,10 +12,10 @@ from sklearn.utils.validation import check_is_fitted
 from ..align._config import DEVICE_PARAMETER, PRESET_PARAMETER
 from ..methods import FitContext, get_method
 from ..utils import check_series_collection
-from ..utils._common_params import MANIFOLD, N_JOBS, RANDOM_STATE, VERBOSE
+from ..utils._common_params import DTW_WINDOW, MANIFOLD, N_JOBS, RANDOM_STATE, VERBOSE
 from ..utils._params import declare_parameters, validate_parameters
 from ._core import dtw_to_centroids, kmeans
-from ._params import DTW_WINDOW, MAX_ITER, METHOD, N_CLUSTERS, N_INIT, TOL, setting_hint
+from ._params import MAX_ITER, METHOD, N_CLUSTERS, N_INIT, TOL, setting_hint
 
 KMEANS_PARAMETERS = (
     N_CLUSTERS, METHOD, MANIFOLD, PRESET_PARAMETER, N_INIT, MAX_ITER, TOL, DTW_WINDOW,

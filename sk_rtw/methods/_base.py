@@ -195,7 +195,9 @@ def method_parameter(doc: str) -> Parameter:
         "method",
         (
             Options(METHODS),
-            InstanceOf((AveragingMethod,), "AveragingMethod", "an AveragingMethod such as RTW()"),
+            InstanceOf(
+                "AveragingMethod", "an AveragingMethod such as RTW()", types=(AveragingMethod,)
+            ),
         ),
         doc,
     )

@@ -38,7 +38,7 @@ class EngineMethod(AveragingMethod):
             members = np.flatnonzero(np.isin(codes, groups))
             config = resolve_config(
                 self.name, context.preset, {**explicit, "output_length": int(length)},
-                lengths[members], device=context.device,
+                lengths[members], device=context.device, dtw_window=context.dtw_window,
             )  # fmt: skip
             results = align_collection(
                 collection.subset(members), np.searchsorted(groups, codes[members]),

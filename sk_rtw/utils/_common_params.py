@@ -23,7 +23,11 @@ def _seed_like(value: Any) -> bool:
 
 MANIFOLD = Parameter(
     "manifold",
-    (InstanceOf((str, Manifold), "str or Manifold", "a manifold name or a Manifold object"),),
+    (
+        InstanceOf(
+            "str or Manifold", "a manifold name or a Manifold object", types=(str, Manifold)
+        ),
+    ),
     'Space of the samples: a name ("euclidean", "sphere", "quaternion", "spd", "pose") '
     "takes its dimension from the data, or a Manifold object (your own included).",
 )
@@ -32,9 +36,9 @@ RANDOM_STATE = Parameter(
     (
         Constant(None),
         Satisfies(
-            _seed_like,
             "int, RandomState or Generator",
             "an int in [0, 2**32 - 1], a numpy RandomState or a Generator",
+            predicate=_seed_like,
         ),
     ),
     "Seeds every random choice of the fit (network initialisation, the DTW start's medoid "
@@ -45,9 +49,11 @@ N_JOBS = Parameter(
     (
         Constant(None),
         Satisfies(
-            lambda v: isinstance(v, Integral) and not isinstance(v, (bool, np.bool_)) and v != 0,
             "int",
             "a non-zero integer (-1: all cores)",
+            predicate=lambda v: (
+                isinstance(v, Integral) and not isinstance(v, (bool, np.bool_)) and v != 0
+            ),
         ),
     ),
     "Threads of the fit and of the DTW computations, scikit-learn's convention (None: 1, "
@@ -58,4 +64,10 @@ VERBOSE = Parameter(
     "verbose",
     (Boolean(), Interval(int, 0)),
     "Progress on stderr: 1 (or True) a line per fitted group, 2 also the training loss.",
+)
+DTW_WINDOW = Parameter(
+    "dtw_window",
+    (Interval(float, 0.0, 1.0), Constant(None, "no band")),
+    "Sakoe-Chiba band of the DTW, its radius as a fraction of the shorter series' "
+    "length; None: no band.",
 )

@@ -163,19 +163,11 @@ class Boolean(Constraint):
 
 
 @dataclass(frozen=True)
-class InstanceOf(Constraint):
-    """An instance of one of ``types``; ``normaliser(name, value)`` may refine it."""
+class _Described(Constraint):
+    """A constraint whose two descriptions are given as text."""
 
-    types: tuple[type, ...]
     short_text: str
     description_text: str
-    normaliser: Callable[[str, Any], Any] | None = None
-
-    def accepts(self, value: Any) -> bool:
-        return isinstance(value, self.types)
-
-    def normalise(self, name: str, value: Any) -> Any:
-        return value if self.normaliser is None else self.normaliser(name, value)
 
     @property
     def short(self) -> str:  # type: ignore[override]
@@ -187,23 +179,27 @@ class InstanceOf(Constraint):
 
 
 @dataclass(frozen=True)
-class Satisfies(Constraint):
+class InstanceOf(_Described):
+    """An instance of one of ``types``; ``normaliser(name, value)`` may refine it."""
+
+    types: tuple[type, ...] = ()
+    normaliser: Callable[[str, Any], Any] | None = None
+
+    def accepts(self, value: Any) -> bool:
+        return isinstance(value, self.types)
+
+    def normalise(self, name: str, value: Any) -> Any:
+        return value if self.normaliser is None else self.normaliser(name, value)
+
+
+@dataclass(frozen=True)
+class Satisfies(_Described):
     """Any value for which ``predicate`` holds (for rules no interval states)."""
 
-    predicate: Callable[[Any], bool]
-    short_text: str
-    description_text: str
+    predicate: Callable[[Any], bool] = bool
 
     def accepts(self, value: Any) -> bool:
         return bool(self.predicate(value))
-
-    @property
-    def short(self) -> str:  # type: ignore[override]
-        return self.short_text
-
-    @property
-    def description(self) -> str:  # type: ignore[override]
-        return self.description_text
 
 
 @dataclass(frozen=True)
