@@ -252,3 +252,60 @@ def test_the_documented_centroid_length_is_the_one_used():
     for k in range(2):
         members = np.asarray(lengths)[km.labels_ == k]
         assert len(km.cluster_centers_[k]) == rule(members)
+
+
+# ------------------------------------------------------------ choices from the data (26)
+def shifted_bumps(n_per=8, seed=0):
+    """Two classes of the same bump, early and late: DTW without a band warps the shift
+    away (the classes look alike); a narrow band keeps them apart."""
+    rng = np.random.default_rng(seed)
+    t = np.linspace(0, 1, 50)
+    X = [np.exp(-((t - c - rng.normal(0, 0.02)) ** 2) / 0.003) + 0.05 * rng.standard_normal(50)
+         for c in [0.3] * n_per + [0.7] * n_per]  # fmt: skip
+    return np.array(X), np.repeat([0, 1], n_per)
+
+
+def test_an_auto_window_is_chosen_from_the_training_series_and_used_in_the_fit():
+    from sk_rtw.estimators._selection import WINDOWS
+
+    X, y = shifted_bumps()
+    X_test, y_test = shifted_bumps(seed=1)
+    unbanded = RTWNearestCentroid(method="dba").fit(X, y)
+    auto = RTWNearestCentroid(method="dba", dtw_window="auto", random_state=0).fit(X, y)
+    assert auto.dtw_window_ is not None and auto.dtw_window_ < 0.3
+    assert [c["dtw_window"] for c in auto.selection_["candidates"]] == list(WINDOWS)
+    assert auto.score(X_test, y_test) == 1.0 > unbanded.score(X_test, y_test)
+    # the same window given explicitly: the same means (the choice is what the fit used)
+    explicit = RTWNearestCentroid(method="dba", dtw_window=auto.dtw_window_).fit(X, y)
+    np.testing.assert_array_equal(explicit.means_, auto.means_)
+    engine = RTWNearestCentroid(method=quick(), dtw_window="auto", random_state=0).fit(X, y)
+    assert {a.config.dtw_window for a in engine.alignments_} == {engine.dtw_window_}
+
+
+def test_auto_centroids_split_a_class_made_of_two_shapes():
+    """Class 0 holds series near +1 and near -1, class 1 series near 0: one centroid of
+    class 0 sits near 0 too, two centroids do not."""
+    rng = np.random.default_rng(0)
+    levels = [1.0, -1.0] * 6 + [0.0] * 6
+    X = np.array([level + 0.1 * rng.standard_normal(30) for level in levels])
+    y = np.array([0] * 12 + [1] * 6)
+    auto = RTWNearestCentroid(method="dba", n_centroids="auto", random_state=0).fit(X, y)
+    assert auto.n_centroids_ >= 2 and len(auto.means_) >= 4
+    scores = {c["n_centroids"]: c["accuracy"] for c in auto.selection_["candidates"]}
+    assert scores[auto.n_centroids_] > scores[1]
+    assert auto.score(X, y) == 1.0
+    simple = RTWNearestCentroid(method="dba", n_centroids="auto", random_state=0)
+    assert simple.fit(*three_shapes()).n_centroids_ == 1  # one shape per class: one centroid
+
+
+def test_auto_choices_need_classes_and_fall_back_without_folds():
+    X, y = three_shapes()
+    with pytest.raises(ValueError, match="need y with at least 2 classes"):
+        RTWAverager(method="dba", dtw_window="auto").fit(X)
+    y_single = y.copy()
+    y_single[0] = 9  # a class of one series: no stratified fold
+    fallback = RTWNearestCentroid(method="dba", dtw_window="auto", n_centroids="auto").fit(
+        X, y_single
+    )
+    assert fallback.dtw_window_ is None and fallback.n_centroids_ == 1
+    assert "no fold" in fallback.selection_["criterion"]

@@ -16,7 +16,7 @@ from ..utils import check_series_collection
 from ..utils._params import declare_parameters, validate_parameters
 from ._core import fit_centroids, kmeans
 from ._params import AVERAGER_DEFAULTS, AVERAGER_PARAMETERS, setting_hint
-from ._selection import CENTROIDS, cv_accuracy, folds, loo_window
+from ._selection import choose
 
 
 @declare_parameters(AVERAGER_PARAMETERS, AVERAGER_DEFAULTS, hint=setting_hint)
@@ -168,19 +168,8 @@ class RTWAverager(TransformerMixin, BaseEstimator):
                 '"auto" choices are made by classifying the training series: they need y '
                 "with at least 2 classes"
             )
-        if window == "auto":
-            window, scores = loo_window(collection, codes, n_jobs=self.n_jobs)
-            self.selection_["dtw_window"] = scores
-        if n_centroids == "auto":
-            splits = folds(codes, self.random_state)
-            largest = max(1, min(int(np.bincount(codes).min()), max(CENTROIDS)))
-            candidates = [k for k in CENTROIDS if k <= largest] or [1]
-            scores = {
-                k: cv_accuracy(self, collection, codes, splits, dtw_window=window, n_centroids=k)
-                for k in candidates
-            } if splits and len(candidates) > 1 else {1: float("nan")}  # fmt: skip
-            n_centroids = max(scores, key=lambda k: (scores[k], -k))
-            self.selection_["n_centroids"] = scores
+        window, n_centroids, self.selection_ = choose(self, collection, codes, window,
+                                                      n_centroids)  # fmt: skip
         return window, n_centroids
 
     def _centroid_distances(self, X: Any) -> np.ndarray:

@@ -44,6 +44,7 @@ def fit_centroids(
     names: list[Any] | None = None,
     kind: str = "group",
     owner: str = "RTWAverager",
+    starts: list[np.ndarray] | None = None,
 ) -> list[Any]:
     """One centroid per group of ``collection`` (``codes``: group of every series).
 
@@ -63,6 +64,8 @@ def fit_centroids(
         What a group is, for the ``verbose`` lines ("class", "cluster").
     owner : str, default="RTWAverager"
         The estimator's name, for the ``verbose`` lines.
+    starts : list of ndarray, optional
+        A current average of every group (k-means' previous centroids).
 
     Returns
     -------
@@ -73,7 +76,7 @@ def fit_centroids(
     n_groups = int(codes.max()) + 1
     names = list(range(n_groups)) if names is None else names
     start = time.perf_counter()
-    fitted = method.fit_groups(collection, codes, seeds, context)
+    fitted = method.fit_groups(collection, codes, seeds, context, starts)
     if context.verbose:
         seconds = time.perf_counter() - start
         sizes = np.bincount(codes, minlength=n_groups)
@@ -237,8 +240,9 @@ def kmeans(
         stacked = np.concatenate([run.index for run in active])
         codes = np.concatenate([run.labels + offsets[i] for i, run in enumerate(active)])
         seeds = [int(run.rng.randint(2**31 - 1)) for run in active for _ in range(run.n_clusters)]
+        starts = [c for run in active for c in run.centroids]  # warm starts (DBA)
         fitted = fit_centroids(method, collection.subset(stacked), codes, seeds, context,
-                               kind="cluster", owner=owner)  # fmt: skip
+                               kind="cluster", owner=owner, starts=starts)  # fmt: skip
         for i, (run, filled) in enumerate(zip(active, refilled, strict=True)):
             run.fits = fitted[offsets[i] : offsets[i + 1]]
             run.centroids = [fit.mean for fit in run.fits]

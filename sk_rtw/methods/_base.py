@@ -130,6 +130,7 @@ class AveragingMethod(BaseEstimator):
         codes: np.ndarray,
         seeds: list[int],
         context: FitContext,
+        starts: list[np.ndarray] | None = None,
     ) -> list[Any]:
         """Average every group of ``collection``; one :class:`AveragingResult` per group.
 
@@ -141,6 +142,9 @@ class AveragingMethod(BaseEstimator):
         seeds : list of int
             One seed per group.
         context : FitContext
+        starts : list of ndarray, optional
+            A current average of every group (k-means' previous centroids), for methods
+            that iterate from one (DBA); the engine's methods start from their own.
 
         Returns
         -------

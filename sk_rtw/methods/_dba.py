@@ -30,10 +30,10 @@ class DBAConfig:
         return dataclasses.asdict(self)
 
 
-def _fit_one(collection: SeriesCollection, config: DBAConfig):
+def _fit_one(collection: SeriesCollection, config: DBAConfig, init: Any = "medoid"):
     start = time.perf_counter()
     result = dba_average(collection, window=config.window, max_iter=config.max_iter,
-                         tol=config.tol)  # fmt: skip
+                         tol=config.tol, init=init)  # fmt: skip
     return dataclasses.replace(result, config=config, fit_time=time.perf_counter() - start)
 
 
@@ -44,7 +44,8 @@ class DBA(AveragingMethod):
     Each iteration aligns every series of a group to the current average by manifold DTW
     (squared geodesic costs) and replaces each sample of the average by the Fréchet mean
     of the points matched to it (:func:`sk_rtw.baselines.dba_average`); the average
-    starts at the group's DTW medoid and keeps its length. The DTW band is the
+    starts at the group's DTW medoid (in k-means rounds: at the cluster's current
+    centroid, as in Petitjean et al.'s k-means) and keeps its length. The DTW band is the
     estimator's ``dtw_window``. Every setting defaults to ``"auto"``, the value of the
     estimator's preset (the same in every preset).
 
@@ -61,13 +62,18 @@ class DBA(AveragingMethod):
         codes: np.ndarray,
         seeds: list[int],
         context: FitContext,
+        starts: list[np.ndarray] | None = None,
     ) -> list[Any]:
         values = resolve_knobs(self.name, context.preset, self.settings())
         config = DBAConfig("dba", context.preset, values["max_iter"], values["tol"],
                            context.dtw_window)  # fmt: skip
         codes = np.asarray(codes, dtype=np.int64)
         members = [np.flatnonzero(codes == g) for g in range(int(codes.max()) + 1)]
-        jobs = [delayed(_fit_one)(collection.subset(idx), config) for idx in members]
+        inits = ["medoid"] * len(members) if starts is None else list(starts)
+        jobs = [
+            delayed(_fit_one)(collection.subset(idx), config, init)
+            for idx, init in zip(members, inits, strict=True)
+        ]
         if context.n_jobs in (None, 1) or len(members) == 1:
             return [fn(*args, **kwargs) for fn, args, kwargs in jobs]
         return list(Parallel(n_jobs=context.n_jobs)(jobs))

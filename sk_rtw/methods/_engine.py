@@ -23,6 +23,7 @@ class EngineMethod(AveragingMethod):
         codes: np.ndarray,
         seeds: list[int],
         context: FitContext,
+        starts: list[np.ndarray] | None = None,
     ) -> list[Any]:
         explicit = self.settings()
         codes = np.asarray(codes, dtype=np.int64)
