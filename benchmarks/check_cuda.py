@@ -26,7 +26,15 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from sk_rtw import NTWNearestCentroid, RTWNearestCentroid, TTWAverager, align  # noqa: E402
+from sk_rtw import (  # noqa: E402
+    NTW,
+    RTW,
+    TTW,
+    NTWNearestCentroid,
+    RTWNearestCentroid,
+    TTWAverager,
+    align,
+)
 from sk_rtw.datasets import make_warped_signals  # noqa: E402
 from sk_rtw.manifolds import SPD, Euclidean, Product, Quaternion, Sphere  # noqa: E402
 
@@ -79,8 +87,12 @@ def main() -> int:
     X = np.concatenate([make_warped_signals(Quaternion(), 8, 40, seed).signals for seed in (1, 2)])
     y = np.repeat([0, 1], 8)
     for estimator in (
-        RTWNearestCentroid(manifold="quaternion", n_epochs=20, random_state=0, device="cuda"),
-        NTWNearestCentroid(manifold="quaternion", n_epochs=20, random_state=0, device="cuda"),
+        RTWNearestCentroid(
+            manifold="quaternion", method=RTW(n_epochs=20), random_state=0, device="cuda"
+        ),
+        NTWNearestCentroid(
+            manifold="quaternion", method=NTW(n_epochs=20), random_state=0, device="cuda"
+        ),
     ):
         estimator.fit(X, y)
         restored = pickle.loads(pickle.dumps(estimator))
@@ -93,7 +105,7 @@ def main() -> int:
             f"means are numpy: {numpy_means}"
         )
     spd = np.concatenate([make_warped_signals(SPD(2), 6, 30, seed).signals for seed in (3, 4)])
-    averager = TTWAverager(manifold="spd", n_epochs=10, random_state=0, device="cuda")
+    averager = TTWAverager(manifold="spd", method=TTW(n_epochs=10), random_state=0, device="cuda")
     distances = averager.fit(spd, np.repeat([0, 1], 6)).transform(spd)
     print(f"TTWAverager on cuda (SPD(2)): means {averager.means_.shape}, {distances.shape}")
     print("all checks passed" if not failures else f"{failures} check(s) FAILED")

@@ -15,6 +15,12 @@ Prints
    otherwise).
 2. ``manifolds``: RTWKMeans where no peer runs: RCFS letters on S^2 and S^3, R-LASA shapes
    on S^3 and SPD(2) (demonstrations from ``--demo-dir``), ARI against the shape labels.
+4. ``classify``: the tuned nearest-centroid classifier
+   (``RTWNearestCentroid(n_centroids="auto", dtw_window="auto")``, RTW and DBA centroids)
+   beside the default one and 1-NN DTW on labelled demonstrations on curved manifolds
+   (the letters and shapes of section 2, and the two pose tasks in R^3 x S^3), every
+   other demonstration of a class for training: test accuracy, chosen window and
+   centroids, fit and prediction seconds.
 3. ``centroids``: nearest centroid with ``n_centroids`` = 1, 2, 4, 8 DBA (or, with
    ``--centroid-method rtw``, RTW) centroids per class, and with ``k`` chosen by 3-fold
    cross-validation on the training split
@@ -38,12 +44,13 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
+from benchmarks._shared import method_object  # noqa: E402
 from benchmarks.ucr._data import AEON_BUNDLED, available_datasets, load_split  # noqa: E402
 from sk_rtw import RTWKMeans, RTWNearestCentroid, dtw_pairwise_distance  # noqa: E402
 from sk_rtw.manifolds import Sphere  # noqa: E402
 
 CENTROIDS = (1, 2, 4, 8)
-SECTIONS = ("tslearn", "manifolds", "centroids")
+SECTIONS = ("tslearn", "manifolds", "centroids", "classify")
 
 
 def inertia(X, centres, labels) -> float:
@@ -83,8 +90,8 @@ def section_tslearn(names, data_dir, epochs: int) -> None:
         rows["tslearn"] = (score, adjusted_rand_score(y, tk.labels_), seconds)
         for method in ("dba", "rtw"):
             start = time.perf_counter()
-            km = RTWKMeans(k, method=method, n_init=2, max_iter=10, n_epochs=epochs,
-                           random_state=0).fit(X)  # fmt: skip
+            km = RTWKMeans(k, method=method_object(method, n_epochs=epochs), n_init=2,
+                           max_iter=10, random_state=0).fit(X)  # fmt: skip
             rows[method] = (km.inertia_, adjusted_rand_score(y, km.labels_),
                             time.perf_counter() - start)  # fmt: skip
         cells = [
@@ -137,12 +144,60 @@ def section_manifolds(demo_dir: str | None, epochs: int) -> None:
         out = {}
         for method in ("dba", "rtw"):
             start = time.perf_counter()
-            km = RTWKMeans(k, method=method, manifold=manifold, n_init=2, n_epochs=epochs,
-                           random_state=0).fit(X)  # fmt: skip
+            km = RTWKMeans(k, method=method_object(method, n_epochs=epochs), manifold=manifold,
+                           n_init=2, random_state=0).fit(X)  # fmt: skip
             out[method] = (adjusted_rand_score(y, km.labels_), time.perf_counter() - start)
         print(f"{name:>24} {len(X):>4} {X.shape[1]:>4} {k:>3} | {out['dba'][0]:>8.3f} "
               f"{out['rtw'][0]:>8.3f} | {out['dba'][1]:>6.1f} {out['rtw'][1]:>6.1f}",
               flush=True)  # fmt: skip
+
+
+def labelled_demonstrations(root):
+    """(name, manifold, series, labels): section 2's data and the two pose tasks."""
+    from benchmarks.paper._data import icsc_carrot_grating, icsc_wiping
+
+    yield from manifold_datasets(root)
+    grating = [s[::20] for s in icsc_carrot_grating(root)]
+    wiping = [s[::10] for s in icsc_wiping(root)]
+    yield "poses: grating or wiping", "pose", grating + wiping, np.repeat([0, 1], [12, 4])
+
+
+def section_classify(demo_dir: str | None, epochs: int) -> None:
+    from benchmarks.paper._data import data_dir
+
+    try:
+        root = data_dir(demo_dir)
+    except FileNotFoundError as exc:
+        print(f"\n4. {exc}: section skipped")
+        return
+    rows = {
+        "default rtw": ("rtw", {}),
+        "tuned rtw": ("rtw", {"n_centroids": "auto", "dtw_window": "auto"}),
+        "tuned dba": ("dba", {"n_centroids": "auto", "dtw_window": "auto"}),
+    }
+    print(f"\n4. Tuned nearest centroid on curved manifolds (RTW: {epochs} epochs), every "
+          "other demonstration of a class for training")  # fmt: skip
+    print(f"{'data':>26} {'n':>4} | " + " ".join(f"{r:>22}" for r in rows)
+          + f" {'1-NN DTW':>9}")  # fmt: skip
+    for name, manifold, X, y in labelled_demonstrations(root):
+        X = list(X)
+        train = np.concatenate([np.flatnonzero(y == c)[0::2] for c in np.unique(y)])
+        test = np.setdiff1d(np.arange(len(y)), train)
+        cells = []
+        for method, params in rows.values():
+            settings = method_object(method, n_epochs=epochs)
+            clf = RTWNearestCentroid(manifold=manifold, method=settings, random_state=0, **params)
+            start = time.perf_counter()
+            clf.fit([X[i] for i in train], y[train])
+            fit = time.perf_counter() - start
+            accuracy = clf.score([X[i] for i in test], y[test])
+            choice = f"w={clf.dtw_window_},k={clf.n_centroids_}" if params else ""
+            cells.append(f"{accuracy:.3f} {choice} {fit:.0f}s")
+        nearest = dtw_pairwise_distance([X[i] for i in test], [X[i] for i in train],
+                                        manifold=clf.manifold_).argmin(1)  # fmt: skip
+        one_nn = float((y[train][nearest] == y[test]).mean())
+        print(f"{name:>26} {len(y):>4} | " + " ".join(f"{c:>22}" for c in cells)
+              + f" {one_nn:>9.3f}", flush=True)  # fmt: skip
 
 
 def section_centroids(names, data_dir, method="dba") -> None:
@@ -229,6 +284,8 @@ def main(argv=None) -> None:
         section_manifolds(args.demo_dir, args.epochs)
     if "centroids" in args.sections:
         section_centroids(names, args.data_dir, args.centroid_method)
+    if "classify" in args.sections:
+        section_classify(args.demo_dir, args.epochs)
 
 
 if __name__ == "__main__":

@@ -182,6 +182,35 @@ def halves_markdown(records: list[dict], methods: list[str]) -> list[str]:
         costs = [(x, y) for x, y in costs if x is not None and y is not None]
         cost_cell = f"{sum(x <= y for x, y in costs)} / {len(costs)}" if costs else "-"
         lines.append(f"| {a} | {b} | " + " | ".join(cells) + f" | {cost_cell} |")
+    lines += [
+        "",
+        "Seconds over all datasets (fit; prediction of the test splits), and the median "
+        "per dataset of the prediction time of 1-NN DTW over the method's:",
+        "",
+        "| method | fit | predict | prediction speed-up over 1-NN DTW (median) | "
+        "chosen windows / centroids |",
+        "| --- | --- | --- | --- | --- |",
+    ]
+    for m in methods:
+        entries = [r["methods"][m] for r in done if "accuracy" in r["methods"].get(m, {})]
+        if not entries:
+            continue
+        fit = sum(e["fit_seconds"] for e in entries)
+        predict = sum(e["predict_seconds"] for e in entries)
+        ratios = [
+            r["methods"]["1nn-dtw"]["predict_seconds"]
+            / max(r["methods"][m]["predict_seconds"], 1e-9)
+            for r in done
+            if "accuracy" in r["methods"].get("1nn-dtw", {})
+            and "accuracy" in r["methods"].get(m, {})
+        ]
+        speed = f"{np.median(ratios):.1f}x" if ratios and m != "1nn-dtw" else "-"
+        picks = [(e.get("dtw_window"), e.get("n_centroids")) for e in entries]
+        chosen = "-"
+        if m.endswith("-tuned"):
+            counts = {pick: picks.count(pick) for pick in sorted(set(picks), key=str)}
+            chosen = "; ".join(f"w={w}, k={k}: {n}" for (w, k), n in counts.items())
+        lines.append(f"| {m} | {fit:.0f} | {predict:.1f} | {speed} | {chosen} |")
     return [*lines, ""]
 
 

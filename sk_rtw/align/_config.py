@@ -66,6 +66,7 @@ class AlignmentConfig:
     device: str
     cuda_graph: bool = False
     dtw_window: float | None = None
+    refine_steps: int = 0
 
     def to_dict(self) -> dict[str, Any]:
         """The configuration as a plain dictionary (field name to value).

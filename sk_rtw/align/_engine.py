@@ -38,6 +38,7 @@ from ._density import density_representatives
 from ._knobs import ENGINE_METHODS, KNOBS
 from ._layout import GroupLayout
 from ._loss import window_weights
+from ._refine import refine_mean
 from ._sinc import TABLE_BYTES, SincInterpolator
 from ._start import dtw_start
 from ._training import Trainer, progress_printer
@@ -422,8 +423,16 @@ def align_collection(
             costs = group_loss.cpu().numpy()
     factor = 1.0 if scale is None else scale
     manifold = collection.manifold
-    fit_time = time.perf_counter() - start_time
     mean_np, aligned_np, warps_np = mean.cpu().numpy(), aligned.cpu().numpy(), warps.cpu().numpy()
+    if config.refine_steps > 0:  # the means as free points, towards a lower DTW cost
+        mean_np = np.stack([
+            refine_mean(
+                [collection.series(i) for i in layout.members(g)], mean_np[g], manifold,
+                steps=config.refine_steps, window=config.dtw_window,
+            ).mean
+            for g in range(layout.n_groups)
+        ])  # fmt: skip
+    fit_time = time.perf_counter() - start_time
     results = []
     for g in range(layout.n_groups):
         idx = layout.members(g)

@@ -194,6 +194,14 @@ KNOBS: dict[str, Knob] = {
             "Capture each epoch in a CUDA graph on a CUDA device (see the GPU guide).",
             _every(False),
         ),
+        Knob(
+            "refine_steps",
+            _integer(0),
+            "Steps, at each of two soft-DTW temperatures, of the final refinement of the mean "
+            "as free points on the manifold towards a lower DTW cost to the series (0: none; "
+            "see sk_rtw.align._refine).",
+            _every(0),
+        ),
         Knob("max_iter", _integer(1), "Most DBA refinement iterations.", {"dba": 10}),
     )
 }

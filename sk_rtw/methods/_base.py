@@ -20,7 +20,7 @@ import numpy as np
 from sklearn.base import BaseEstimator, clone
 
 from ..align._config import METHOD_LABELS, check_knobs
-from ..align._knobs import METHODS, method_knobs, owners
+from ..align._knobs import ENGINE_METHODS, METHODS, method_knobs, owners
 from ..manifolds import Manifold
 from ..utils import SeriesCollection
 from ..utils._params import AUTO, InstanceOf, Options, Parameter
@@ -157,16 +157,34 @@ class AveragingMethod(BaseEstimator):
         return f"cost {result.cost:.4g} after {result.n_iter} iterations"
 
 
-def method_class(method: str):
-    """Class decorator: an :class:`AveragingMethod` with ``method``'s knobs as parameters,
-    every one ``"auto"`` by default, documented from the knob table."""
+def method_class(method: str, summary: str):
+    """Class decorator: an :class:`AveragingMethod` named ``method`` with its knobs as
+    parameters, every one ``"auto"`` by default; the docstring is ``summary`` and the
+    knobs' documentation."""
     from ..utils._params import declare_parameters
 
     knobs = [knob.with_auto() for knob in method_knobs(method)]
-    return declare_parameters(
+    label = METHOD_LABELS[method]
+    decorate = declare_parameters(
         knobs, dict.fromkeys((k.name for k in knobs), AUTO), positional=0,
         hint=_knob_hint(method),
     )  # fmt: skip
+
+    where = " or of :func:`sk_rtw.align`" if method in ENGINE_METHODS else ""
+
+    def build(cls):
+        cls.name = method
+        cls.__doc__ = (
+            f"{summary}\n\n    The settings of the {label} averaging of an estimator\n"
+            f"    (``RTWNearestCentroid(method={label}(...))``, each searchable as "
+            f"``method__<setting>``){where}.\n"
+            '    Every setting defaults to ``"auto"``: the value of the preset (see the '
+            "presets table\n    of the user guide).\n\n"
+            "    Parameters\n    ----------\n    %(parameters)s\n    "
+        )
+        return decorate(cls)
+
+    return build
 
 
 def _registry() -> dict[str, type[AveragingMethod]]:

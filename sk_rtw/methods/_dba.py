@@ -37,25 +37,17 @@ def _fit_one(collection: SeriesCollection, config: DBAConfig, init: Any = "medoi
     return dataclasses.replace(result, config=config, fit_time=time.perf_counter() - start)
 
 
-@method_class("dba")
+@method_class(
+    "dba",
+    "DTW barycenter averaging with Fréchet means (Petitjean et al., 2011), any manifold.\n\n"
+    "    Each iteration aligns every series of a group to the current average by manifold\n"
+    "    DTW (squared geodesic costs) and replaces each sample of the average by the\n"
+    "    Fréchet mean of the points matched to it (:func:`sk_rtw.baselines.dba_average`);\n"
+    "    the average starts at the group's DTW medoid (in k-means rounds: at the cluster's\n"
+    "    current centroid, as in Petitjean et al.'s k-means) and keeps its length. The DTW\n"
+    "    band is the estimator's ``dtw_window``.",
+)
 class DBA(AveragingMethod):
-    """DTW barycenter averaging with Fréchet means (Petitjean et al., 2011), any manifold.
-
-    Each iteration aligns every series of a group to the current average by manifold DTW
-    (squared geodesic costs) and replaces each sample of the average by the Fréchet mean
-    of the points matched to it (:func:`sk_rtw.baselines.dba_average`); the average
-    starts at the group's DTW medoid (in k-means rounds: at the cluster's current
-    centroid, as in Petitjean et al.'s k-means) and keeps its length. The DTW band is the
-    estimator's ``dtw_window``. Every setting defaults to ``"auto"``, the value of the
-    estimator's preset (the same in every preset).
-
-    Parameters
-    ----------
-    %(parameters)s
-    """
-
-    name = "dba"
-
     def fit_groups(
         self,
         collection: SeriesCollection,

@@ -54,48 +54,16 @@ class EngineMethod(AveragingMethod):
         return f"best epoch {result.best_epoch + 1} of {result.n_iter} run"
 
 
-@method_class("rtw")
+@method_class("rtw", "Riemannian Time Warping: neural warps, windowed sinc, Gaussian window loss.")
 class RTW(EngineMethod):
-    """Riemannian Time Warping: neural warps, windowed sinc, Gaussian window loss.
-
-    The settings of the RTW averaging of an estimator
-    (``RTWNearestCentroid(method=RTW(hidden_size=32))``, searchable as
-    ``method__hidden_size``). Every setting defaults to ``"auto"``: the value of the
-    estimator's preset (see the presets table of the user guide).
-
-    Parameters
-    ----------
-    %(parameters)s
-    """
-
-    name = "rtw"
+    pass
 
 
-@method_class("ttw")
+@method_class("ttw", "Riemannian Trainable Time Warping: sine-series warps, pointwise loss.")
 class TTW(EngineMethod):
-    """Riemannian Trainable Time Warping: sine-series warps, pointwise loss.
-
-    The settings of the TTW averaging of an estimator; every setting defaults to
-    ``"auto"``, the value of the estimator's preset.
-
-    Parameters
-    ----------
-    %(parameters)s
-    """
-
-    name = "ttw"
+    pass
 
 
-@method_class("ntw")
+@method_class("ntw", "Riemannian Neural Time Warping: zero-initialised network, full sinc.")
 class NTW(EngineMethod):
-    """Riemannian Neural Time Warping: zero-initialised network, full sinc, pointwise loss.
-
-    The settings of the NTW averaging of an estimator; every setting defaults to
-    ``"auto"``, the value of the estimator's preset.
-
-    Parameters
-    ----------
-    %(parameters)s
-    """
-
-    name = "ntw"
+    pass
