@@ -197,6 +197,22 @@ def test_centroids_per_class_use_the_classifiers_engine_settings():
     assert np.array_equal(clf.centroid_classes_[clf.assignments_], codes)
 
 
+def test_assignments_are_the_series_each_centroid_was_averaged_from():
+    """The last k-means round can move series to another centroid after it was averaged:
+    ``assignments_`` stays the averaging's membership, ``alignments_[k].aligned`` its
+    series (ItalyPowerDemand, seed 2: the last RTW round moves some)."""
+    from aeon.datasets import load_classification
+
+    X, y = load_classification("ItalyPowerDemand", split="train")
+    clf = RTWAverager(method=RTW(n_epochs=4), n_centroids=4, dtw_window=0.0, random_state=2)
+    clf.fit(X[:, 0], y)
+    for k, fit in enumerate(clf.alignments_):
+        members = np.flatnonzero(clf.assignments_ == k)
+        assert len(fit.aligned) == len(members)
+    _, codes = np.unique(y, return_inverse=True)
+    assert np.array_equal(clf.centroid_classes_[clf.assignments_], codes)
+
+
 def test_centroid_settings_belong_to_the_method_and_are_checked():
     X, _ = three_shapes()
     with pytest.raises(TypeError, match="method=RTW"):
@@ -309,3 +325,4 @@ def test_auto_choices_need_classes_and_fall_back_without_folds():
     )
     assert fallback.dtw_window_ is None and fallback.n_centroids_ == 1
     assert "no fold" in fallback.selection_["criterion"]
+    assert fallback.selection_["seconds"] >= 0  # every report says what the search cost

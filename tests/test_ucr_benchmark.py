@@ -169,6 +169,9 @@ def test_a_method_that_fails_everywhere_fails_the_run(tmp_path, monkeypatch, cap
     assert "every fit of dba failed" in capsys.readouterr().err
     record = json.loads((tmp_path / "datasets" / "ItalyPowerDemand.json").read_text())
     assert record["methods"]["1nn-dtw"]["accuracy"] > 0  # the other method still ran
+    failed = record["methods"]["dba"]
+    assert failed["error"] == "RuntimeError: no averaging today"
+    assert "in broken" in failed["traceback"]  # where it failed, for the reader of the record
 
 
 def test_the_documented_output_length_is_the_one_used(tmp_path, capsys):
@@ -256,3 +259,45 @@ def test_a_run_on_a_dask_cluster_started_the_usual_way(tmp_path, capsys):
                 process.wait(timeout=10)
             except subprocess.TimeoutExpired:
                 process.kill()
+
+
+def test_tuned_rows_share_one_search_and_the_halves_report_adds_up(tmp_path, capsys):
+    """Both tuned rows record the same choice (one search per dataset, its seconds in both
+    fit times); the halves report splits alphabetically and its cells are the records'."""
+    out = tmp_path / "run"
+    args = ["--datasets", "ItalyPowerDemand", "GunPoint", "ArrowHead", "--methods", "dba",
+            "dba-tuned", "rtw-tuned", "1nn-dtw", "--epochs", "2", "--max-series-per-class",
+            "6", "--halves", "--quiet", "--out", str(out)]  # fmt: skip
+    assert main(args) == 0
+    records = {
+        name: json.loads((out / "datasets" / f"{name}.json").read_text())
+        for name in ("ArrowHead", "GunPoint", "ItalyPowerDemand")
+    }
+    for record in records.values():
+        dba, rtw = record["methods"]["dba-tuned"], record["methods"]["rtw-tuned"]
+        assert (dba["dtw_window"], dba["n_centroids"]) == (rtw["dtw_window"], rtw["n_centroids"])
+        assert dba["selection"] == rtw["selection"] and len(dba["selection"]["candidates"]) == 20
+        assert rtw["fit_seconds"] >= rtw["selection"]["seconds"] > 0
+        best = max(c["accuracy"] for c in dba["selection"]["candidates"])
+        pick = (dba["dtw_window"], dba["n_centroids"])
+        scores = {
+            (c["dtw_window"], c["n_centroids"]): c["accuracy"]
+            for c in dba["selection"]["candidates"]
+        }
+        assert scores[pick] == best
+    summary = (out / "summary.md").read_text().split("## Halves")[1]
+    assert "Half A: alphabetical positions 1, 3, 5, ... (ArrowHead, ItalyPowerDemand)" in summary
+    assert "half B: 2, 4, 6, ... (GunPoint)" in summary
+    row = next(line for line in summary.splitlines() if line.startswith("| dba | 0"))
+    half_a = np.mean(
+        [records[n]["methods"]["dba"]["accuracy"] for n in ("ArrowHead", "ItalyPowerDemand")]
+    )
+    assert row.split(" | ")[1] == f"{half_a:.4f} (n=2)"
+    pair = next(
+        line for line in summary.splitlines() if line.startswith("| dba-tuned | 1nn-dtw |")
+    )
+    at_least = sum(
+        r["methods"]["dba-tuned"]["accuracy"] >= r["methods"]["1nn-dtw"]["accuracy"]
+        for r in records.values()
+    )
+    assert pair.split(" | ")[4] == f"{at_least} / 3"

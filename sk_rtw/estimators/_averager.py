@@ -55,7 +55,8 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         Per entry of ``means_``: the method's result (mean, aligned series, warps, cost,
         iterations run, resolved ``config``; see :class:`sk_rtw.methods.AveragingResult`).
     assignments_ : ndarray of shape (n_series,)
-        Entry of ``means_`` that every training series was averaged into.
+        Entry of ``means_`` that every training series was averaged into
+        (``alignments_[k].aligned`` holds the series with ``assignments_ == k``).
     method_ : str
         The averaging method used.
     manifold_ : Manifold
@@ -66,7 +67,9 @@ class RTWAverager(TransformerMixin, BaseEstimator):
     n_centroids_ : int
         Centroids per class (``n_centroids``, or the number chosen for ``"auto"``).
     selection_ : dict
-        The training-data scores behind the ``"auto"`` choices (empty without them).
+        The training-data scores behind the ``"auto"`` choices (empty without them):
+        ``"criterion"``, ``"candidates"`` (every candidate with its cross-validated
+        accuracy) and ``"seconds"`` (the time the search took, part of the fit).
     n_features_in_ : int
         Length of the training series when they all have the same length (a
         scikit-learn convention; series of any length are accepted by ``transform``).
@@ -144,7 +147,7 @@ class RTWAverager(TransformerMixin, BaseEstimator):
             offsets = np.concatenate([[0], np.cumsum(counts)[:-1]])
             assignments = np.empty(collection.n_series, dtype=np.int64)
             for c, clustering in enumerate(clusterings):
-                assignments[codes == c] = offsets[c] + clustering.labels
+                assignments[codes == c] = offsets[c] + clustering.members
         self.classes_ = classes
         self.method_ = method.name
         self.manifold_ = collection.manifold

@@ -110,13 +110,19 @@ def dtw_to_centroids(
 
 @dataclass
 class Clustering:
-    """The outcome of :func:`kmeans` for one problem."""
+    """The outcome of :func:`kmeans` for one problem.
+
+    ``labels`` assign every series to its nearest centroid; ``members`` are the labels the
+    centroids were averaged from (``fits[k].aligned`` holds the series with ``members ==
+    k``). They differ where the last round moved series to another centroid.
+    """
 
     centroids: list[np.ndarray]
     labels: np.ndarray
     inertia: float
     n_iter: int
     fits: list[Any] = field(default_factory=list)
+    members: np.ndarray | None = None
 
 
 def _inertia(distances: np.ndarray, labels: np.ndarray) -> float:
@@ -175,6 +181,7 @@ class _Run:
     labels: np.ndarray
     inertia: float
     fits: list[Any] = field(default_factory=list)
+    members: np.ndarray | None = None
     best: Clustering | None = None
     n_iter: int = 0
     done: bool = False
@@ -234,6 +241,7 @@ def kmeans(
         refilled = []
         for run in active:
             run.labels, filled = fill_empty(run.labels, run.distances, run.n_clusters)
+            run.members = run.labels
             refilled.append(filled)
         # every cluster of every active problem is one group of one batched fit
         offsets = np.cumsum([0] + [run.n_clusters for run in active])
@@ -264,7 +272,7 @@ def kmeans(
             full = np.all(np.bincount(run.labels, minlength=run.n_clusters) > 0)
             if full and (run.best is None or run.inertia < run.best.inertia):
                 run.best = Clustering(list(run.centroids), run.labels.copy(), run.inertia,
-                                      iteration, list(run.fits))  # fmt: skip
+                                      iteration, list(run.fits), run.members)  # fmt: skip
             if changed == 0 or (filled == 0 and improved <= tol * abs(run.inertia)):
                 run.done = True
     out = []
@@ -272,7 +280,7 @@ def kmeans(
         if run.best is None:  # every iterate left a cluster empty: keep the last, filled
             labels, _ = fill_empty(run.labels, run.distances, run.n_clusters)
             run.best = Clustering(list(run.centroids), labels, _inertia(run.distances, labels),
-                                  run.n_iter, list(run.fits))  # fmt: skip
+                                  run.n_iter, list(run.fits), run.members)  # fmt: skip
         run.best.n_iter = run.n_iter
         out.append(run.best)
     return out

@@ -76,7 +76,9 @@ class RTWKMeans(ClusterMixin, TransformerMixin, BaseEstimator):
     n_iter_ : int
         Rounds run by the kept seeding (its best iterate is returned).
     alignments_ : list of Alignment or MultipleAlignment
-        The averaging method's result of every cluster (as :class:`RTWAverager`'s).
+        The averaging method's result of every cluster (as :class:`RTWAverager`'s): the
+        series averaged into each centre, i.e. the assignment before the last round, which
+        can differ from ``labels_`` (the nearest centre) where that round moved series.
     manifold_ : Manifold
     n_features_in_ : int
         Length of the training series when they are univariate of one length.

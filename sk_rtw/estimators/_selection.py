@@ -20,6 +20,7 @@ of the best leave-one-out 1-NN accuracy (the UCR archive's "learned window", whi
 
 from __future__ import annotations
 
+import time
 from typing import Any
 
 import numpy as np
@@ -47,11 +48,13 @@ def choose(
     """Resolve ``"auto"`` window and centroid count (module docstring); their scores."""
     from ..methods import DBA
 
+    start = time.perf_counter()
     proxy = clone(estimator).set_params(method=DBA(), verbose=0)
     splits = folds(codes, estimator.random_state)
     report: dict[str, Any] = {"criterion": f"{len(splits)}-fold accuracy of DBA centroids"}
     if not splits:  # a class of one series: nothing to validate on
         report["criterion"] = "no fold possible (a class of one series): the defaults"
+        report["seconds"] = time.perf_counter() - start
         return (
             (None if window == "auto" else window),
             (1 if n_centroids == "auto" else n_centroids),
@@ -68,6 +71,7 @@ def choose(
     report["candidates"] = [
         {"dtw_window": w, "n_centroids": k, "accuracy": v} for (w, k), v in scores.items()
     ]
+    report["seconds"] = time.perf_counter() - start
     return window, n_centroids, report
 
 
