@@ -15,18 +15,18 @@ Prints
    otherwise).
 2. ``manifolds``: RTWKMeans where no peer runs: RCFS letters on S^2 and S^3, R-LASA shapes
    on S^3 and SPD(2) (demonstrations from ``--demo-dir``), ARI against the shape labels.
-4. ``classify``: the tuned nearest-centroid classifier
-   (``RTWNearestCentroid(n_centroids="auto", dtw_window="auto")``, RTW and DBA centroids)
-   beside the default one and 1-NN DTW on labelled demonstrations on curved manifolds
-   (the letters and shapes of section 2, and the two pose tasks in R^3 x S^3), every
-   other demonstration of a class for training: test accuracy, chosen window and
-   centroids, fit and prediction seconds.
 3. ``centroids``: nearest centroid with ``n_centroids`` = 1, 2, 4, 8 DBA (or, with
    ``--centroid-method rtw``, RTW) centroids per class, and with ``k`` chosen by 3-fold
    cross-validation on the training split
    (``GridSearchCV``), against 1-NN DTW (both with sk_rtw's DTW, absolute point cost):
    test accuracy and prediction seconds per dataset, and the count of datasets where
    the cross-validated ``k`` is at least as accurate as 1-NN DTW.
+4. ``classify``: the tuned nearest-centroid classifier
+   (``RTWNearestCentroid(n_centroids="auto", dtw_window="auto")``, RTW and DBA centroids)
+   beside the default one and 1-NN DTW on labelled demonstrations on curved manifolds
+   (the letters and shapes of section 2, and the two pose tasks in R^3 x S^3), every
+   other demonstration of a class for training: test accuracy, chosen window and
+   centroids, fit seconds.
 """
 
 from __future__ import annotations

@@ -154,3 +154,31 @@ def test_settings_of_the_paper_runs_are_checked_on_the_command_line(capsys):
     with pytest.raises(SystemExit):
         inverted_s1.main(["--epochs", "-3"])
     assert "is not an integer >= 0" in capsys.readouterr().err
+
+
+def test_the_clustering_benchmark_classifies_manifold_demonstrations(monkeypatch, capsys):
+    """Section 4 of benchmarks/clustering.py on two well-separated shapes on S^2: every row
+    is printed with its accuracy, the tuned rows with their choice, and 1-NN DTW."""
+    from benchmarks import clustering
+    from benchmarks.paper import _data
+
+    t = np.linspace(0, 1, 30)
+    rng = np.random.default_rng(0)
+    X, y = [], []
+    for label, bend in enumerate((0.2, -0.2)):
+        for _ in range(6):
+            shifted = np.clip(t + 0.05 * rng.standard_normal(), 0, 1)
+            angle = np.stack([shifted, bend * np.sin(np.pi * shifted)], axis=1)
+            X.append(np.concatenate([np.sin(angle), np.cos(angle).prod(1, keepdims=True)], 1))
+            y.append(label)
+    X = [x / np.linalg.norm(x, axis=1, keepdims=True) for x in X]
+    monkeypatch.setattr(_data, "data_dir", lambda demo_dir: demo_dir)
+    data = [("two arcs on S^2", "sphere", X, np.array(y))]
+    monkeypatch.setattr(clustering, "labelled_demonstrations", lambda root: iter(data))
+    clustering.section_classify("unused", epochs=2)
+    line = next(row for row in capsys.readouterr().out.splitlines() if "two arcs" in row)
+    assert line.split("|")[0].split()[-1] == "12"
+    cells = line.split("|")[1].split()
+    assert cells[0] == "1.000"  # default RTW separates the arcs
+    assert line.count("w=") == 2 and line.count("k=") == 2
+    assert float(cells[-1]) == 1.0  # 1-NN DTW

@@ -6,7 +6,9 @@ For one dataset and each method:
    ``dba`` are :class:`sk_rtw.RTWNearestCentroid` with that ``method`` (product defaults),
    ``rtw-paper`` is RTW with ``preset="paper"``, ``rtw-equal`` RTW with the paper's
    equal-weight mean (``method=RTW(mean_weights="equal")``), ``rtw-alignment`` RTW with
-   ``preset="alignment"`` (align's defaults, means of ``min(N, 4) T``); ``aeon-dba`` is aeon's
+   ``preset="alignment"`` (align's defaults, means of ``min(N, 4) T``), ``rtw-refined`` the
+   default with ``refine_steps=2`` (soft-DTW refinement of each mean), ``rtw-tuned`` and
+   ``dba-tuned`` with ``n_centroids="auto", dtw_window="auto"``; ``aeon-dba`` is aeon's
    ``elastic_barycenter_average`` with DTW (a reference where the data are Euclidean);
 2. averaging values, per training series: ``alignment`` = DTW of the *warped* (aligned)
    series to its class mean (the paper's averaging score; not for aeon's DBA) and
@@ -59,6 +61,8 @@ ESTIMATOR_METHODS: dict[str, tuple[str, dict, str, dict]] = {
     # defaults (equal weights on the average time axis, 3 start rounds, Z = min(N, 4) T)
     "rtw-equal": ("rtw", {"mean_weights": "equal"}, "class-means", {}),
     "rtw-alignment": ("rtw", {}, "alignment", {}),
+    # the default followed by the soft-DTW refinement of each mean (refine_steps=2)
+    "rtw-refined": ("rtw", {"refine_steps": 2}, "class-means", {}),
     "ttw": ("ttw", {}, "class-means", {}),
     "ntw": ("ntw", {}, "class-means", {}),
     "dba": ("dba", {}, "class-means", {}),
@@ -73,7 +77,8 @@ ALL_METHODS = (*ESTIMATOR_METHODS, *REFERENCE_METHODS)
 DEFAULT_METHODS = tuple(
     m
     for m in ALL_METHODS
-    if m not in ("rtw-paper", "rtw-equal", "rtw-alignment", "rtw-tuned", "dba-tuned")
+    if m
+    not in ("rtw-paper", "rtw-equal", "rtw-alignment", "rtw-refined", "rtw-tuned", "dba-tuned")
 )
 
 

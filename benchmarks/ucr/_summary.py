@@ -220,6 +220,7 @@ def halves_markdown(records: list[dict], methods: list[str]) -> list[str]:
 #: The comparisons of the halves report (first method against second).
 HALF_PAIRS = (
     ("rtw", "dba"),
+    ("rtw-refined", "dba"),
     ("rtw-tuned", "dba-tuned"),
     ("rtw-tuned", "1nn-dtw"),
     ("dba-tuned", "1nn-dtw"),

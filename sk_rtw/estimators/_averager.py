@@ -35,8 +35,9 @@ class RTWAverager(TransformerMixin, BaseEstimator):
     What to set: ``manifold`` for your data; ``method`` and ``preset`` choose the
     averaging (the default, density-weighted RTW means of the median class length, is
     what classifies best on the UCR development archive; ``preset="paper"`` is the
-    paper's configuration); the method's own settings go in its object,
-    ``method=RTW(n_epochs=64)``.
+    paper's configuration); ``n_centroids`` for classes of several shapes (``"auto"``
+    chooses it, and ``dtw_window="auto"`` the band, from the training labels); the
+    method's own settings go in its object, ``method=RTW(n_epochs=64)``.
 
     Parameters
     ----------

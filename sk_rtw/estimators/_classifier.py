@@ -66,11 +66,15 @@ class RTWNearestCentroid(ClassifierMixin, RTWAverager):
     ``predict`` returns the class of the nearest mean (paper, section V-A).
 
     What to set: ``manifold`` for your data, nothing else to start with (density-weighted
-    RTW means of each class's median length, the best nearest-centroid accuracy measured
-    on the UCR development archive); ``method="dba"`` for the fastest fit;
-    ``n_centroids`` for classes of several shapes; ``dtw_window`` to band the DTW;
-    ``preset="paper"`` for the paper's exact configuration. The method's own settings go
-    in its object: ``method=RTW(n_epochs=64)``, searchable as ``method__n_epochs``.
+    RTW means of each class's median length, the best one-mean-per-class accuracy measured
+    on the UCR development archive). For the most accurate classifier set
+    ``n_centroids="auto", dtw_window="auto"``: the band and the centroids per class are
+    chosen by cross-validation on the training data (on the development archive on
+    average level with 1-NN DTW, 4 points above one mean per class, predicting about 20x
+    faster than 1-NN DTW, for a fit about 17x longer). ``method="dba"`` for the fastest
+    fit; ``preset="paper"`` for the paper's exact configuration. The method's own
+    settings go in its object: ``method=RTW(n_epochs=64)``, searchable as
+    ``method__n_epochs``.
 
     Parameters
     ----------
