@@ -24,15 +24,15 @@ N_CENTROIDS = Parameter(
     (Interval(int, 1), Options(("auto",))),
     "Centroids per class. Above 1 each class is clustered by k-means with the same "
     "averaging method (k-means++ seeding, at most 10 rounds, at most one centroid per "
-    'series). "auto": chosen from the training data (fitted n_centroids_; see '
-    "selection_).",
+    'series). "auto": chosen from the training data (fitted ``n_centroids_``; '
+    "see ``selection_``).",
 )
 DTW_WINDOW = Parameter(
     "dtw_window",
     (Interval(float, 0.0, 1.0), Constant(None, "no band"), Options(("auto",))),
     "Sakoe-Chiba band of every DTW of the fit (the DTW start of RTW, TTW and NTW, DBA, "
     "k-means) and of prediction, its radius as a fraction of the shorter series' length; "
-    'None: no band. "auto": chosen from the training data (fitted dtw_window_).',
+    'None: no band. "auto": chosen from the training data (fitted ``dtw_window_``).',
 )
 TEMPERATURE = Parameter(
     "temperature",
