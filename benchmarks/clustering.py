@@ -127,13 +127,20 @@ def manifold_datasets(demo_dir: Path):
     yield "R-LASA shapes on SPD(2)", "spd", np.concatenate(spds), shape_labels
 
 
-def section_manifolds(demo_dir: str | None, epochs: int) -> None:
+def demo_root(demo_dir: str | None, section: str) -> Path | None:
+    """The demonstration folder, or None after saying that ``section`` is skipped."""
     from benchmarks.paper._data import data_dir
 
     try:
-        root = data_dir(demo_dir)
+        return data_dir(demo_dir)
     except FileNotFoundError as exc:
-        print(f"\n2. {exc}: section skipped")
+        print(f"\n{section}. {exc} (this script: --demo-dir): section skipped")
+        return None
+
+
+def section_manifolds(demo_dir: str | None, epochs: int) -> None:
+    root = demo_root(demo_dir, "2")
+    if root is None:
         return
     print(f"\n2. RTWKMeans on curved manifolds (no peer runs here), k = shapes, n_init 2 "
           f"(RTW: {epochs} epochs)")  # fmt: skip
@@ -163,12 +170,8 @@ def labelled_demonstrations(root):
 
 
 def section_classify(demo_dir: str | None, epochs: int) -> None:
-    from benchmarks.paper._data import data_dir
-
-    try:
-        root = data_dir(demo_dir)
-    except FileNotFoundError as exc:
-        print(f"\n4. {exc}: section skipped")
+    root = demo_root(demo_dir, "4")
+    if root is None:
         return
     rows = {
         "default rtw": ("rtw", {}),

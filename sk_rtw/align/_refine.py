@@ -29,7 +29,6 @@ from ..dtw._dtw import point_cost_matrix
 from ..dtw._soft import soft_dtw_batch
 from ..manifolds import Manifold
 from ..manifolds._mean import frechet_mean
-from ..utils import SeriesCollection
 
 #: The soft-DTW temperatures of the refinement, relative to the mean squared cost per
 #: sample of the DTW paths to the start. Measured on half A of the UCR development
@@ -95,17 +94,23 @@ def refine_mean(
     if steps <= 0 or best_cost <= 0:
         return Refinement(best, start_cost, best_cost, done)
     scale = best_cost / (len(series) * len(best))
-    current = best
     lengths = np.array([len(s) for s in series])
-    flat = manifold.is_flat
+    ends = np.cumsum(lengths)
+    stacked = np.concatenate(series)  # every sample once, for one cost matrix per step
+    # (N, T_max, *point_shape), the padding never weighted (E is zero there)
+    padded = np.zeros((len(series), lengths.max(), *best.shape[1:]))
+    for n, s in enumerate(series):
+        padded[n, : len(s)] = s
+    current = best
     for gamma in gammas:
         for _ in range(steps):
             costs = np.zeros((len(series), len(current), lengths.max()))
-            for n, s in enumerate(series):
-                costs[n, :, : len(s)] = point_cost_matrix(current, s, manifold, squared=True)
+            joint = point_cost_matrix(current, stacked, manifold, squared=True)
+            for n, part in enumerate(np.split(joint, ends[:-1], axis=1)):
+                costs[n, :, : lengths[n]] = part
             _, E = soft_dtw_batch(costs, np.full(len(series), len(current)), lengths,
                                   gamma * scale, band)  # fmt: skip
-            current = _majorised_mean(series, current, E, manifold, flat)
+            current = _majorised_mean(padded, current, E, manifold)
             done += 1
             cost = _hard_cost(series, current, manifold, window)
             if cost < best_cost:
@@ -113,47 +118,24 @@ def refine_mean(
     return Refinement(best, start_cost, best_cost, done)
 
 
-def _majorised_mean(series, current, E, manifold: Manifold, flat: bool) -> np.ndarray:
-    """Every sample: the Fréchet mean of all series samples weighted by ``E[n, i, j]``."""
-    if flat:  # exact: one weighted average per sample
-        total = sum(E[n, :, : len(s)] @ s.reshape(len(s), -1) for n, s in enumerate(series))
-        weights = E.sum((0, 2))
-        return (total / weights[:, None]).reshape(current.shape)
-    rows, points, weights = [], [], []
-    for n, s in enumerate(series):
-        e = E[n, :, : len(s)]
-        keep = e > WEIGHT_FLOOR * e.max(1, keepdims=True)
-        i, j = np.nonzero(keep)
-        rows.append(i)
-        points.append(s[j])
-        weights.append(e[i, j])
-    codes = np.concatenate(rows)
+def _majorised_mean(padded, current, E, manifold: Manifold) -> np.ndarray:
+    """Every sample: the Fréchet mean of all series samples weighted by ``E[n, i, j]``
+    (``padded``: the series ``(N, T_max, *point_shape)``)."""
+    if manifold.is_flat:  # exact: one weighted average per sample
+        flat = padded.reshape(*padded.shape[:2], -1)
+        total = np.einsum("nij,njd->id", E, flat)
+        return (total / E.sum((0, 2))[:, None]).reshape(current.shape)
+    keep = E > WEIGHT_FLOOR * E.max(2, keepdims=True)
+    n, i, j = np.nonzero(keep)
     with torch.no_grad():
         mean = frechet_mean(
             manifold,
-            torch.as_tensor(np.concatenate(points)),
-            torch.as_tensor(np.concatenate(weights)),
-            torch.as_tensor(codes),
+            torch.as_tensor(padded[n, j]),
+            torch.as_tensor(E[n, i, j]),
+            torch.as_tensor(i),
             start=torch.as_tensor(current),
             max_iter=8,
             tol=0.0,
             differentiate="none",
         )
     return mean.numpy()
-
-
-def refine_collection(
-    collection: SeriesCollection,
-    codes: np.ndarray,
-    means: list[np.ndarray],
-    *,
-    steps: int,
-    window: float | None = None,
-) -> list[Refinement]:
-    """:func:`refine_mean` for every group of a stacked collection."""
-    out = []
-    for g, mean in enumerate(means):
-        members = np.flatnonzero(codes == g)
-        series = [collection.series(i) for i in members]
-        out.append(refine_mean(series, mean, collection.manifold, steps=steps, window=window))
-    return out
