@@ -10,8 +10,9 @@ from __future__ import annotations
 from ..align._config import DEVICE_PARAMETER, METHOD_LABELS, PRESET_PARAMETER
 from ..align._knobs import owners
 from ..methods._base import method_parameter
+from ..utils._common_params import DTW_WINDOW as BAND
 from ..utils._common_params import MANIFOLD, N_JOBS, RANDOM_STATE, VERBOSE
-from ..utils._params import Constant, Interval, Options, Parameter
+from ..utils._params import Interval, Options, Parameter
 
 METHOD = method_parameter(
     'Averaging method: "rtw", "ttw", "ntw", "dba" (DTW barycenter averaging with Fréchet '
@@ -29,7 +30,7 @@ N_CENTROIDS = Parameter(
 )
 DTW_WINDOW = Parameter(
     "dtw_window",
-    (Interval(float, 0.0, 1.0), Constant(None, "no band"), Options(("auto",))),
+    (*BAND.constraints, Options(("auto",))),
     "Sakoe-Chiba band of every DTW of the fit (the DTW start of RTW, TTW and NTW, DBA, "
     "k-means) and of prediction, its radius as a fraction of the shorter series' length; "
     'None: no band. "auto": chosen from the training data (fitted ``dtw_window_``).',
