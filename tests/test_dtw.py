@@ -89,6 +89,32 @@ def aeon_band(nx, ny, window):
     return create_bounding_matrix(nx, ny, window=window)
 
 
+@pytest.mark.parametrize("window", [0.0, 0.05, 0.1, 0.33, 0.9])
+def test_band_rows_are_aeons_bounding_matrix(window):
+    from sk_rtw.dtw._kernels import sakoe_chiba_rows
+
+    for nx in range(1, 30):
+        for ny in (1, 2, 7, nx, 2 * nx + 1, 29):
+            lo, hi = sakoe_chiba_rows(nx, ny, window)
+            cols = np.arange(ny)
+            mask = (cols >= lo[:, None]) & (cols < hi[:, None])
+            np.testing.assert_array_equal(mask, aeon_band(nx, ny, window), err_msg=f"{nx}x{ny}")
+
+
+@pytest.mark.parametrize("window", [0.0, 0.05, 0.2])
+def test_banded_unequal_length_pairwise_matches_aeon(window, rng):
+    X = [rng.standard_normal(n) for n in (20, 31, 26, 57)]
+    Y = [rng.standard_normal(n) for n in (18, 40, 57)]
+    expected = np.array([[aeon_dtw_distance(x, y, window=window) for y in Y] for x in X])
+    np.testing.assert_allclose(
+        dtw_pairwise_distance(X, Y, squared=True, window=window), expected, rtol=1e-12
+    )
+    expected = np.array([[aeon_dtw_distance(x, y, window=window) for y in X] for x in X])
+    np.testing.assert_allclose(
+        dtw_pairwise_distance(X, squared=True, window=window), expected, rtol=1e-12, atol=1e-12
+    )
+
+
 @pytest.mark.parametrize("manifold", MANIFOLDS, ids=repr)
 @pytest.mark.parametrize("squared", [False, True])
 def test_matches_python_reference_on_manifolds(manifold, squared):

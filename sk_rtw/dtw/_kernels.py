@@ -46,30 +46,44 @@ def sakoe_chiba_rows(nx: int, ny: int, window: float):
     """Allowed column range ``[lo[i], hi[i])`` of each row of an ``nx x ny`` DTW matrix.
 
     ``window`` is the band radius as a fraction of the shorter series (aeon's convention);
-    a negative value means no band.
+    a negative value means no band. The band follows the diagonal of the ``a x b`` matrix
+    (``a`` the shorter side) step by step: at step ``s`` of ``max(a, b) + 1`` the cells
+    ``(r, floor(s b / steps))`` with ``|r - floor(s a / steps)| <= floor(window a)`` are
+    allowed. One sweep over the steps (``O(nx + ny)``); ``lo`` and ``hi`` are
+    non-decreasing.
     """
     lo = np.zeros(nx, dtype=np.int64)
     hi = np.full(nx, ny, dtype=np.int64)
     if window < 0.0 or window >= 1.0:
         return lo, hi
-    lo[:] = ny
-    hi[:] = 0
     transpose = nx > ny
     a, b = (ny, nx) if transpose else (nx, ny)
     steps = max(a, b) + 1
     thickness = int(window * min(a, b))
+    covered = 0  # rows [0, covered) have their lo (not transposed)
+    released = 0  # rows [0, released) have their hi (not transposed)
+    previous = 0
     for step in range(steps):
         ai = math.floor(step / steps * a)
         bi = math.floor(step / steps * b)
         start = max(0, ai - thickness)
         stop = min(a, ai + thickness + 1)
-        for r in range(start, stop):
-            # cell (r, bi) of the a x b matrix is allowed
-            i, j = (bi, r) if transpose else (r, bi)
-            if j < lo[i]:
-                lo[i] = j
-            if j + 1 > hi[i]:
-                hi[i] = j + 1
+        if transpose:  # row bi of the nx x ny matrix holds the columns [start, stop)
+            if step == 0 or bi != previous:
+                lo[bi] = start
+            hi[bi] = stop
+        else:  # rows [start, stop) hold column bi: first step sets lo, last one hi
+            while covered < stop:
+                lo[covered] = bi
+                covered += 1
+            while released < start:
+                hi[released] = previous + 1
+                released += 1
+        previous = bi
+    if not transpose:
+        while released < a:
+            hi[released] = previous + 1
+            released += 1
     return lo, hi
 
 
@@ -98,6 +112,33 @@ def _accumulate_row(cost_row, prev, cur, i, lo, hi, ny):
 
 
 @njit(cache=True, inline="always")
+def _band_row(cost_row, prev, cur, lo, hi):
+    """:func:`_accumulate_row` for two rows that are reused: only the band is written.
+
+    Both buffers start as ``inf`` (:func:`_two_rows`). Because ``lo`` and ``hi`` never
+    decrease, the entries that the next row reads outside this row's band are either
+    still ``inf`` or the one at ``lo`` (column ``lo - 1``), which is reset here: a row
+    costs its band's width, not the series' length.
+    """
+    cur[lo] = _INF
+    left = _INF
+    for j in range(lo, hi):
+        best = prev[j]
+        if prev[j + 1] < best:
+            best = prev[j + 1]
+        if left < best:
+            best = left
+        left = cost_row[j] + best
+        cur[j + 1] = left
+
+
+@njit(cache=True, inline="always")
+def _two_rows(ny):
+    """The buffers of :func:`_band_row`: the row "before" row 0 and an ``inf`` row."""
+    return _first_prev(ny), np.full(ny + 1, _INF)
+
+
+@njit(cache=True, inline="always")
 def _first_prev(ny):
     """The row "before" row 0: zero at the sentinel, ``inf`` elsewhere."""
     prev = np.full(ny + 1, _INF)
@@ -122,10 +163,9 @@ def accumulated_cost(cost: np.ndarray, window: float) -> np.ndarray:
 def final_cost(cost: np.ndarray, nx: int, ny: int, window: float) -> float:
     """DTW distance over the top-left ``nx x ny`` block of ``cost`` (two rows of memory)."""
     lo, hi = sakoe_chiba_rows(nx, ny, window)
-    prev = _first_prev(ny)
-    cur = np.empty(ny + 1)
+    prev, cur = _two_rows(ny)
     for i in range(nx):
-        _accumulate_row(cost[i], prev, cur, i, lo[i], hi[i], ny)
+        _band_row(cost[i], prev, cur, lo[i], hi[i])
         prev, cur = cur, prev
     return prev[ny]
 
@@ -293,7 +333,8 @@ def pairwise_segments(X, lx, Y, ly, segments, squared, window, symmetric):
     """DTW between every series of ``X`` and of ``Y``, the cost rows computed in numba.
 
     Each cost row is computed just before the recursion consumes it, so the cost matrix
-    never leaves the cache. Returns the distances, shape ``(len(X), len(Y))``.
+    never leaves the cache, and only within the band: a narrow band costs its width.
+    Returns the distances, shape ``(len(X), len(Y))``.
     """
     n, m = X.shape[0], Y.shape[0]
     values = np.zeros((n, m))
@@ -306,11 +347,11 @@ def pairwise_segments(X, lx, Y, ly, segments, squared, window, symmetric):
         nx, ny = lx[i], ly[j]
         lo, hi = sakoe_chiba_rows(nx, ny, window)
         row = np.empty(ty)
-        prev = _first_prev(ny)
-        cur = np.empty(ny + 1)
+        prev, cur = _two_rows(ny)
         for r in range(nx):
-            _cost_row(X[i], Y[j], r, ny, segments, squared, row)
-            _accumulate_row(row, prev, cur, r, lo[r], hi[r], ny)
+            a, b = lo[r], hi[r]  # the recursion reads no cost outside the band
+            _cost_row(X[i], Y[j, a:b], r, b - a, segments, squared, row[a:b])
+            _band_row(row, prev, cur, a, b)
             prev, cur = cur, prev
         values[i, j] = prev[ny]
     if symmetric:
