@@ -133,7 +133,12 @@ def test_outputs_and_probabilities():
     decision = clf.decision_function(X)
     assert decision.shape == (12,)
     np.testing.assert_array_equal(clf.classes_[(decision > 0).astype(int)], clf.predict(X))
-    assert clf.means_.shape[0] == 2 and len(clf.alignments_) == 2
+    # the default: several centroids per class, each with its result and its class
+    assert len(clf.means_) == len(clf.alignments_) == len(clf.centroid_classes_)
+    assert set(clf.centroid_classes_.tolist()) == {0, 1}
+    one = RTWNearestCentroid(method=RTW(n_epochs=15, hidden_size=16), n_centroids=1,
+                             dtw_window=None, random_state=0).fit(X, y)  # fmt: skip
+    assert one.means_.shape[0] == 2 and len(one.alignments_) == 2
 
 
 def test_averager_without_labels_and_with_a_single_series_class():
@@ -266,7 +271,7 @@ def test_dba_method_equals_the_baseline_per_class():
     from sk_rtw.baselines import dba_average
 
     X, y = two_shape_classes(n_per_class=4, length=30)
-    clf = RTWNearestCentroid(method="dba").fit(X, y)
+    clf = RTWNearestCentroid(method="dba", n_centroids=1, dtw_window=None).fit(X, y)
     for k, label in enumerate(clf.classes_):
         expected = dba_average(X[y == label]).mean
         np.testing.assert_allclose(clf.means_[k], expected, atol=1e-12)
@@ -308,7 +313,9 @@ def test_grid_search_over_mean_weights():
     """The class-means choice (density or the paper's equal weights) is a searchable
     setting of the method, and it changes the fitted means."""
     X, y = two_shape_classes(n_per_class=4, length=30)
-    base = RTWNearestCentroid(method=RTW(n_epochs=3, hidden_size=8), random_state=0)
+    base = RTWNearestCentroid(
+        method=RTW(n_epochs=3, hidden_size=8), n_centroids=1, dtw_window=None, random_state=0
+    )
     search = GridSearchCV(base, {"method__mean_weights": ["equal", "density"]}, cv=2).fit(X, y)
     assert np.isfinite(search.cv_results_["mean_test_score"]).all()
     equal = clone(base).set_params(method__mean_weights="equal").fit(X, y)

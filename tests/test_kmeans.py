@@ -141,7 +141,7 @@ def test_one_centroid_per_class_is_each_classs_mean():
     """n_centroids=1 (the default) averages each class once, with no clustering: the
     means are the DBA baseline of every class, each series assigned to its own class."""
     X, y = three_shapes()
-    one = RTWNearestCentroid(method="dba", n_centroids=1, random_state=0).fit(X, y)
+    one = RTWNearestCentroid(method="dba", n_centroids=1, dtw_window=None).fit(X, y)
     for k in range(3):
         np.testing.assert_allclose(one.means_[k], dba_average(X[y == k]).mean, atol=1e-12)
     np.testing.assert_array_equal(one.centroid_classes_, [0, 1, 2])
@@ -151,8 +151,8 @@ def test_one_centroid_per_class_is_each_classs_mean():
 def test_several_centroids_capture_a_class_made_of_two_shapes():
     X, y = three_shapes()
     y = np.where(y == 2, 0, y)  # class 0: two different shapes; its mean fits neither
-    one = RTWNearestCentroid(method="dba", random_state=0).fit(X, y)
-    two = RTWNearestCentroid(method="dba", n_centroids=2, random_state=0).fit(X, y)
+    one = RTWNearestCentroid(method="dba", n_centroids=1, dtw_window=None).fit(X, y)
+    two = RTWNearestCentroid(method="dba", n_centroids=2, dtw_window=None).fit(X, y)
     assert len(two.means_) == 4 and two.centroid_classes_.tolist() == [0, 0, 1, 1]
     distances = two.transform(X)
     assert distances.shape == (18, 2)
@@ -170,7 +170,7 @@ def test_n_centroids_is_searchable_and_validated():
         return float(len(estimator.means_))
 
     search = GridSearchCV(
-        RTWNearestCentroid(method="dba", random_state=0), {"n_centroids": [1, 2]}, cv=2,
+        RTWNearestCentroid(method="dba", dtw_window=None), {"n_centroids": [1, 2]}, cv=2,
         scoring=centroids_fitted,
     ).fit(X, y)  # fmt: skip
     np.testing.assert_array_equal(search.cv_results_["mean_test_score"], [2.0, 4.0])
@@ -198,9 +198,8 @@ def test_centroids_per_class_use_the_classifiers_engine_settings():
 
 
 def test_assignments_are_the_series_each_centroid_was_averaged_from():
-    """The last k-means round can move series to another centroid after it was averaged:
-    ``assignments_`` stays the averaging's membership, ``alignments_[k].aligned`` its
-    series (ItalyPowerDemand, seed 2: the last RTW round moves some)."""
+    """``assignments_`` is the partition every centroid was averaged from:
+    ``alignments_[k].aligned`` holds its series, all of its own class."""
     from aeon.datasets import load_classification
 
     X, y = load_classification("ItalyPowerDemand", split="train")
@@ -286,15 +285,15 @@ def test_an_auto_window_is_chosen_from_the_training_series_and_used_in_the_fit()
 
     X, y = shifted_bumps()
     X_test, y_test = shifted_bumps(seed=1)
-    unbanded = RTWNearestCentroid(method="dba").fit(X, y)
-    auto = RTWNearestCentroid(method="dba", dtw_window="auto", random_state=0).fit(X, y)
+    unbanded = RTWNearestCentroid(method="dba", n_centroids=1, dtw_window=None).fit(X, y)
+    auto = RTWNearestCentroid(method="dba", n_centroids=1, random_state=0).fit(X, y)
     assert auto.dtw_window_ is not None and auto.dtw_window_ < 0.3
     assert [c["dtw_window"] for c in auto.selection_["candidates"]] == list(WINDOWS)
     assert auto.score(X_test, y_test) == 1.0 > unbanded.score(X_test, y_test)
     # the same window given explicitly: the same means (the choice is what the fit used)
-    explicit = RTWNearestCentroid(method="dba", dtw_window=auto.dtw_window_).fit(X, y)
-    np.testing.assert_array_equal(explicit.means_, auto.means_)
-    engine = RTWNearestCentroid(method=quick(), dtw_window="auto", random_state=0).fit(X, y)
+    explicit = RTWNearestCentroid(method="dba", n_centroids=1, dtw_window=auto.dtw_window_)
+    np.testing.assert_array_equal(explicit.fit(X, y).means_, auto.means_)
+    engine = RTWNearestCentroid(method=quick(), n_centroids=1, random_state=0).fit(X, y)
     assert {a.config.dtw_window for a in engine.alignments_} == {engine.dtw_window_}
 
 
@@ -305,24 +304,20 @@ def test_auto_centroids_split_a_class_made_of_two_shapes():
     levels = [1.0, -1.0] * 6 + [0.0] * 6
     X = np.array([level + 0.1 * rng.standard_normal(30) for level in levels])
     y = np.array([0] * 12 + [1] * 6)
-    auto = RTWNearestCentroid(method="dba", n_centroids="auto", random_state=0).fit(X, y)
+    auto = RTWNearestCentroid(method="dba", dtw_window=None, random_state=0).fit(X, y)
     assert auto.n_centroids_ >= 2 and len(auto.means_) >= 4
     scores = {c["n_centroids"]: c["accuracy"] for c in auto.selection_["candidates"]}
     assert scores[auto.n_centroids_] > scores[1]
     assert auto.score(X, y) == 1.0
-    simple = RTWNearestCentroid(method="dba", n_centroids="auto", random_state=0)
-    assert simple.fit(*three_shapes()).n_centroids_ == 1  # one shape per class: one centroid
 
 
-def test_auto_choices_need_classes_and_fall_back_without_folds():
+def test_auto_choices_need_classes_and_work_with_a_class_of_one_series():
     X, y = three_shapes()
     with pytest.raises(ValueError, match="need y with at least 2 classes"):
         RTWAverager(method="dba", dtw_window="auto").fit(X)
     y_single = y.copy()
-    y_single[0] = 9  # a class of one series: no stratified fold
-    fallback = RTWNearestCentroid(method="dba", dtw_window="auto", n_centroids="auto").fit(
-        X, y_single
-    )
-    assert fallback.dtw_window_ is None and fallback.n_centroids_ == 1
-    assert "no fold" in fallback.selection_["criterion"]
-    assert fallback.selection_["seconds"] >= 0  # every report says what the search cost
+    y_single[0] = 9  # a class of one series: it cannot be held out (always wrong)
+    clf = RTWNearestCentroid(method="dba").fit(X, y_single)
+    assert clf.predict(X[:1]).tolist() == [9]  # its series is its centroid
+    assert all(c["accuracy"] < 1 for c in clf.selection_["candidates"])
+    assert clf.selection_["seconds"] >= 0  # every report says what the search cost

@@ -17,7 +17,9 @@ estimator: the same series get the same resolved configuration.
   on the DTW reference's time axis, 11 start rounds and lighter smoothing; means as long
   as the median series of their group. Not "alignment" for robots: it halves the S^1
   alignment quality and its pose means move several times faster in places.
-* ``"paper"``: the paper's configuration of each method (section V), ``Z = N T_max``.
+* ``"paper"``: the paper's configuration of each method (section V), ``Z = N T_max``;
+  in an estimator, one mean per class and no band (the paper's protocol) where the
+  other presets choose the band and the centroids from the training data.
 
 DBA's settings are the same in every preset.
 """
@@ -80,6 +82,10 @@ class Preset:
         Values for every engine method (RTW, TTW, NTW) that has the knob.
     methods : mapping of str to mapping
         Values for one method, applied after ``engine``.
+    chooses : bool
+        Whether an estimator's ``"auto"`` band and centroids per class are chosen from
+        the training data (:mod:`sk_rtw.estimators._selection`); otherwise ``"auto"`` is
+        the paper's protocol, one mean per class and no band.
     """
 
     name: str
@@ -87,6 +93,7 @@ class Preset:
     output_length: OutputLength
     engine: Mapping[str, Any] = field(default_factory=dict)
     methods: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
+    chooses: bool = True
 
     def defaults(self, method: str) -> dict[str, Any]:
         """Every knob of ``method`` under this preset (``output_length``: None, the rule)."""
@@ -134,7 +141,12 @@ PRESETS: dict[str, Preset] = {
                 }
             },
         ),
-        Preset("paper", "the paper's configuration of each method (section V)", N_TIMES_LONGEST),
+        Preset(
+            "paper",
+            "the paper's configuration of each method (section V)",
+            N_TIMES_LONGEST,
+            chooses=False,
+        ),
     )
 }
 

@@ -10,13 +10,14 @@ from sklearn.utils import check_random_state, column_or_1d
 from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted
 
+from ..align._presets import PRESETS
 from ..dtw import dtw_pairwise_distance
 from ..methods import FitContext, get_method
 from ..utils import check_series_collection
 from ..utils._params import declare_parameters, validate_parameters
-from ._core import fit_centroids, kmeans
+from ._core import _label, fit_centroids
 from ._params import AVERAGER_DEFAULTS, AVERAGER_PARAMETERS, setting_hint
-from ._selection import choose
+from ._selection import choose, partition
 
 
 @declare_parameters(AVERAGER_PARAMETERS, AVERAGER_DEFAULTS, hint=setting_hint)
@@ -28,16 +29,18 @@ class RTWAverager(TransformerMixin, BaseEstimator):
     :func:`sk_rtw.align` (RTW, TTW, NTW; every class in one batched optimisation) or with
     manifold DTW barycenter averaging (``method="dba"``) -- and keeps the class means;
     ``transform`` returns the manifold-DTW distance of each series to each mean (like
-    ``KMeans.transform``). With ``n_centroids=k`` every class is clustered into ``k``
-    centroids by k-means with the same averaging, and ``transform`` returns the distance
-    to every centroid: features for a downstream classifier.
+    ``KMeans.transform``). With ``n_centroids=k`` every class is split into ``k`` parts by
+    k-medoids on the DTW matrix of its series and every part is averaged, and
+    ``transform`` returns the distance to every centroid: features for a downstream
+    classifier.
 
     What to set: ``manifold`` for your data; ``method`` and ``preset`` choose the
     averaging (the default, density-weighted RTW means of the median class length, is
-    what classifies best on the UCR development archive; ``preset="paper"`` is the
-    paper's configuration); ``n_centroids`` for classes of several shapes (``"auto"``
-    chooses it, and ``dtw_window="auto"`` the band, from the training labels); the
-    method's own settings go in its object, ``method=RTW(n_epochs=64)``.
+    the one mean per class that classifies best on the UCR development archive;
+    ``preset="paper"`` is the paper's configuration); ``n_centroids`` for classes of
+    several shapes (``n_centroids="auto", dtw_window="auto"`` choose both from the
+    training labels, as :class:`RTWNearestCentroid` does by default); the method's own
+    settings go in its object, ``method=RTW(n_epochs=64)``.
 
     Parameters
     ----------
@@ -69,8 +72,11 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         Centroids per class (``n_centroids``, or the number chosen for ``"auto"``).
     selection_ : dict
         The training-data scores behind the ``"auto"`` choices (empty without them):
-        ``"criterion"``, ``"candidates"`` (every candidate with its cross-validated
-        accuracy) and ``"seconds"`` (the time the search took, part of the fit).
+        ``"criterion"``, ``"prior"`` (the choice unless the data clearly prefer another),
+        ``"candidates"`` (every candidate band and number of centroids with its
+        leave-one-out accuracy and its advantage over the prior in standard errors,
+        ``"z"``), ``"n_series"`` and ``"sampled"`` (the series it was made on: a
+        stratified sample of a large training set) and ``"seconds"`` (part of the fit).
     n_features_in_ : int
         Length of the training series when they all have the same length (a
         scikit-learn convention; series of any length are accepted by ``transform``).
@@ -107,7 +113,11 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         return self
 
     def _fit_means(self, X, y, require_two_classes):
-        """Validate every parameter, resolve the "auto" choices, fit the means."""
+        """Validate every parameter, resolve the "auto" choices, fit the means.
+
+        Returns, when the choice ran, the held-out distance of every series it scored to
+        every class and their classes (``Selection.held_out``), else None.
+        """
         params = validate_parameters(self)
         method = get_method(params["method"])
         method.settings()  # every setting of the method checked before any work
@@ -124,57 +134,63 @@ class RTWAverager(TransformerMixin, BaseEstimator):
             )
         window, n_centroids = params["dtw_window"], params["n_centroids"]
         self.selection_ = {}
+        selection = None
         if "auto" in (window, n_centroids):
-            window, n_centroids = self._select(collection, codes, window, n_centroids)
+            if PRESETS[params["preset"]].chooses:
+                selection = self._select(collection, codes, window, n_centroids, params)
+                window, n_centroids = selection.dtw_window, selection.n_centroids
+                self.selection_ = selection.report
+            else:  # the paper's protocol: one mean per class, no band
+                window = None if window == "auto" else window
+                n_centroids = 1 if n_centroids == "auto" else n_centroids
         context = FitContext(
             preset=params["preset"], dtw_window=window, device=params["device"],
             n_jobs=params["n_jobs"], verbose=int(params["verbose"]),
         )  # fmt: skip
-        sizes = np.bincount(codes)
-        seeds = check_random_state(self.random_state).randint(2**31 - 1, size=len(classes))
         owner = type(self).__name__
         if n_centroids == 1:
-            fits = fit_centroids(method, collection, codes, [int(s) for s in seeds], context,
-                                 names=list(classes), kind="class", owner=owner)  # fmt: skip
-            centroid_classes = np.arange(len(classes))
-            assignments = codes
+            groups, owners = codes, np.arange(len(classes))
+            names, kind = list(classes), "class"
         else:
-            rngs = [np.random.RandomState(int(s)) for s in seeds]
-            clusterings = kmeans(collection, codes, [min(n_centroids, int(n)) for n in sizes],
-                                 method, context, rngs, owner=owner)  # fmt: skip
-            fits = [fit for clustering in clusterings for fit in clustering.fits]
-            counts = [len(clustering.fits) for clustering in clusterings]
-            centroid_classes = np.repeat(np.arange(len(classes)), counts)
-            offsets = np.concatenate([[0], np.cumsum(counts)[:-1]])
-            assignments = np.empty(collection.n_series, dtype=np.int64)
-            for c, clustering in enumerate(clusterings):
-                assignments[codes == c] = offsets[c] + clustering.members
+            groups, owners = partition(
+                collection, codes, n_centroids, window, selection=selection,
+                random_state=self.random_state, n_jobs=params["n_jobs"],
+            )  # fmt: skip
+            rank = np.concatenate([np.arange(n) for n in np.bincount(owners)])
+            names = [f"{_label(classes[c])}/{r + 1}" for c, r in zip(owners, rank, strict=True)]
+            kind = "centroid"
+        seeds = check_random_state(self.random_state).randint(2**31 - 1, size=len(owners))
+        fits = fit_centroids(method, collection, groups, [int(s) for s in seeds], context,
+                             names=names, kind=kind, owner=owner)  # fmt: skip
         self.classes_ = classes
         self.method_ = method.name
         self.manifold_ = collection.manifold
         self.dtw_window_ = window
         self.n_centroids_ = n_centroids
         self.alignments_ = fits
-        self.centroid_classes_ = centroid_classes
-        self.assignments_ = assignments
+        self.centroid_classes_ = owners
+        self.assignments_ = groups
         means = [fit.mean for fit in fits]
         same_length = len({len(m) for m in means}) == 1
         self.means_ = np.stack(means) if same_length else means
         if collection.equal_length and collection.manifold.point_shape == (1,):
             self.n_features_in_ = collection.max_length
-        return self
+        if selection is None:
+            return None
+        return selection.held_out, codes[selection.sample]
 
-    def _select(self, collection, codes, window, n_centroids):
+    def _select(self, collection, codes, window, n_centroids, params):
         """Resolve ``dtw_window="auto"`` and ``n_centroids="auto"`` (see
-        :mod:`sk_rtw.estimators._selection`); the scores go to ``selection_``."""
+        :mod:`sk_rtw.estimators._selection`)."""
         if len(np.unique(codes)) < 2:
             raise ValueError(
                 '"auto" choices are made by classifying the training series: they need y '
-                "with at least 2 classes"
+                "with at least 2 classes (or set n_centroids and dtw_window)"
             )
-        window, n_centroids, self.selection_ = choose(self, collection, codes, window,
-                                                      n_centroids)  # fmt: skip
-        return window, n_centroids
+        return choose(
+            collection, codes, window, n_centroids, random_state=self.random_state,
+            n_jobs=params["n_jobs"], verbose=int(params["verbose"]), owner=type(self).__name__,
+        )  # fmt: skip
 
     def _centroid_distances(self, X: Any) -> np.ndarray:
         """Manifold-DTW distance of every series to every entry of ``means_``."""

@@ -51,7 +51,7 @@ def fit_temperature(distances: np.ndarray, labels: np.ndarray) -> float:
 
 @declare_parameters(
     (*AVERAGER_PARAMETERS, TEMPERATURE),
-    {**AVERAGER_DEFAULTS, "temperature": "auto"},
+    {**AVERAGER_DEFAULTS, "n_centroids": "auto", "dtw_window": "auto", "temperature": "auto"},
     hint=setting_hint,
     notes={
         "n_centroids": "A series gets the class of its nearest centroid (Petitjean et al., "
@@ -62,19 +62,24 @@ def fit_temperature(distances: np.ndarray, labels: np.ndarray) -> float:
 class RTWNearestCentroid(ClassifierMixin, RTWAverager):
     """Nearest-centroid classifier: the class whose RTW mean is nearest by manifold DTW.
 
-    ``fit`` learns one Riemannian Time Warping mean per class (as :class:`RTWAverager`);
-    ``predict`` returns the class of the nearest mean (paper, section V-A).
+    ``fit`` learns Riemannian Time Warping centroids of every class (as
+    :class:`RTWAverager`); ``predict`` returns the class of the nearest centroid by
+    manifold DTW (paper, section V-A, with several centroids per class).
 
-    What to set: ``manifold`` for your data, nothing else to start with (density-weighted
-    RTW means of each class's median length, the best one-mean-per-class accuracy measured
-    on the UCR development archive). For the most accurate classifier set
-    ``n_centroids="auto", dtw_window="auto"``: the band and the centroids per class are
-    chosen by cross-validation on the training data (on the development archive on
-    average level with 1-NN DTW, 4 points above one mean per class, predicting about 20x
-    faster than 1-NN DTW, for a fit about 17x longer). ``method="dba"`` for the fastest
-    fit; ``preset="paper"`` for the paper's exact configuration. The method's own
-    settings go in its object: ``method=RTW(n_epochs=64)``, searchable as
-    ``method__n_epochs``.
+    What to set: ``manifold`` for your data, nothing else to start with. By default
+    (``n_centroids="auto", dtw_window="auto"``) ``fit`` chooses the Sakoe-Chiba band (0,
+    0.05, 0.1 or 0.2) and the centroids per class (1, 2, 4 or 8) from the training data:
+    one DTW matrix per band, every candidate scored by leave-one-out nearest-medoid
+    classification of the training series, the band 0.05 with 8 centroids kept unless
+    the held-out series clearly prefer another candidate (``selection_``); each class is
+    then split by k-medoids and every part averaged once. On the UCR development archive
+    (30 datasets, 3 seeds) it is 2.2-2.4 points more accurate than 1-NN DTW on average
+    (0.851-0.853 against 0.829, at least as accurate on 21 of 30), predicts 45-54x faster
+    (median per dataset) and fits in 1.3-1.4x the time of one mean per class. One mean
+    per class, as in the paper's Table II: ``n_centroids=1, dtw_window=None``;
+    ``preset="paper"`` for the paper's exact protocol; ``method="dba"`` for the fastest
+    fit. The method's own settings go in its object: ``method=RTW(n_epochs=64)``,
+    searchable as ``method__n_epochs``.
 
     Parameters
     ----------
@@ -83,8 +88,8 @@ class RTWNearestCentroid(ClassifierMixin, RTWAverager):
     Attributes
     ----------
     classes_ : ndarray of shape (n_classes,)
-    means_ : ndarray of shape (n_means, Z, *point_shape)
-        Every centroid (one per class unless ``n_centroids > 1``).
+    means_ : ndarray of shape (n_means, Z, *point_shape) or list of ndarray
+        Every centroid, ``n_centroids_`` per class (fewer for a smaller class).
     centroid_classes_ : ndarray of shape (n_means,)
         Class index of every entry of ``means_``; :meth:`transform` returns, per class,
         the distance to its nearest centroid (``RTWAverager.transform`` gives every
@@ -100,9 +105,11 @@ class RTWNearestCentroid(ClassifierMixin, RTWAverager):
     n_centroids_ : int
         Centroids per class (chosen for ``"auto"``).
     selection_ : dict
-        The training-data scores behind the ``"auto"`` choices.
+        The training-data scores behind the ``"auto"`` choices (see
+        :class:`RTWAverager`; empty without them).
     temperature_ : float
-        The temperature used by :meth:`predict_proba`.
+        The temperature used by :meth:`predict_proba`, fitted on the choice's held-out
+        distances (on the training distances when nothing was chosen).
 
     Examples
     --------
@@ -117,7 +124,8 @@ class RTWNearestCentroid(ClassifierMixin, RTWAverager):
     """
 
     def fit(self, X: Any, y: Any = None):
-        """Learn one mean per class (and the probability temperature).
+        """Choose the band and the centroids, learn the centroids of every class (and the
+        probability temperature).
 
         Parameters
         ----------
@@ -134,13 +142,20 @@ class RTWNearestCentroid(ClassifierMixin, RTWAverager):
             raise ValueError(
                 f"{type(self).__name__} requires y to be passed, but the target y is None"
             )
-        self._fit_means(X, y, require_two_classes=True)
-        if isinstance(self.temperature, str):  # "auto", checked with the other parameters
+        held_out = self._fit_means(X, y, require_two_classes=True)
+        if not isinstance(self.temperature, str):  # "auto" was checked with the others
+            self.temperature_ = float(self.temperature)
+            return self
+        if held_out is not None and np.isfinite(held_out[0]).all(1).sum() >= 2:
+            # the choice's leave-one-out distances: a centroid that is a training series
+            # is at distance 0 from it, which would make the fitted temperature collapse
+            distances, codes = held_out
+            finite = np.isfinite(distances).all(1)
+            self.temperature_ = fit_temperature(distances[finite], codes[finite])
+        else:
             distances = self.transform(X)
             _, codes = _encode(_check_labels(y, len(distances), True))
             self.temperature_ = fit_temperature(distances, codes)
-        else:
-            self.temperature_ = float(self.temperature)
         return self
 
     def transform(self, X: Any) -> np.ndarray:

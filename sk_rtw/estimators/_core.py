@@ -6,11 +6,11 @@ Class means (:class:`RTWAverager`), several centroids per class and clustering
 
 * :func:`fit_centroids` -- one centroid per group of a stacked collection, by the
   method's :meth:`~sk_rtw.methods.AveragingMethod.fit_groups` (the engine's methods
-  solve all groups in one optimisation; DBA averages group by group);
-* :func:`kmeans` -- Lloyd's iterations with manifold DTW for several independent
-  clustering problems at once (every class of a training set, or the one problem of
-  k-means): each round fits the centroids of every cluster of every unfinished problem
-  in one :func:`fit_centroids` call.
+  solve all groups in one optimisation; DBA averages group by group). The groups are
+  the classes, or the parts of every class (:func:`~sk_rtw.estimators._selection.partition`);
+* :func:`kmeans` -- Lloyd's iterations with manifold DTW for independent clustering
+  problems in lockstep (:class:`RTWKMeans`): each round fits the centroids of every
+  cluster of every unfinished problem in one :func:`fit_centroids` call.
 
 The estimators validate, resolve their settings and store the results; nothing is
 averaged or scored by a second implementation.
@@ -80,7 +80,8 @@ def fit_centroids(
     if context.verbose:
         seconds = time.perf_counter() - start
         sizes = np.bincount(codes, minlength=n_groups)
-        for g in range(n_groups):
+        # a line per class or cluster; a line per centroid only at verbose >= 2
+        for g in range(n_groups if kind != "centroid" or context.verbose >= 2 else 0):
             print(
                 f"[{owner}] {kind} {_label(names[g])!r}: {sizes[g]} series, {method.name}, "
                 f"{method.describe(fitted[g])}",

@@ -23,17 +23,19 @@ METHOD = method_parameter(
 N_CENTROIDS = Parameter(
     "n_centroids",
     (Interval(int, 1), Options(("auto",))),
-    "Centroids per class. Above 1 each class is clustered by k-means with the same "
-    "averaging method (k-means++ seeding, at most 10 rounds, at most one centroid per "
-    'series). "auto": chosen from the training data (fitted ``n_centroids_``; '
-    "see ``selection_``).",
+    "Centroids per class. Above 1 each class is split into that many parts by k-medoids "
+    "on the DTW matrix of its series (band ``dtw_window``; at most one part per series) "
+    'and every part is averaged once. "auto": chosen from the training data with the '
+    "band (fitted ``n_centroids_``, the scores in ``selection_``); one mean per class "
+    'under preset="paper".',
 )
 DTW_WINDOW = Parameter(
     "dtw_window",
     (*BAND.constraints, Options(("auto",))),
     "Sakoe-Chiba band of every DTW of the fit (the DTW start of RTW, TTW and NTW, DBA, "
-    "k-means) and of prediction, its radius as a fraction of the shorter series' length; "
-    'None: no band. "auto": chosen from the training data (fitted ``dtw_window_``).',
+    "the partition into centroids) and of prediction, its radius as a fraction of the "
+    'shorter series\' length; None: no band. "auto": chosen from the training data with '
+    'the centroids (fitted ``dtw_window_``); no band under preset="paper".',
 )
 TEMPERATURE = Parameter(
     "temperature",
