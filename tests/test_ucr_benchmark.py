@@ -261,12 +261,14 @@ def test_a_run_on_a_dask_cluster_started_the_usual_way(tmp_path, capsys):
                 process.kill()
 
 
-def test_tuned_rows_share_one_search_and_the_halves_report_adds_up(tmp_path, capsys):
-    """Both tuned rows record the same choice (one search per dataset, its seconds in both
-    fit times); the halves report splits alphabetically and its cells are the records'."""
+def test_default_rows_make_the_same_choice_and_the_halves_report_adds_up(tmp_path, capsys):
+    """The default classifier's rows (RTW and DBA centroids) record the same choice, made
+    from the training series; the one-mean rows keep one mean per class; the halves report
+    splits alphabetically and its cells are the records'; the verdict states the default
+    classifier against 1-NN DTW."""
     out = tmp_path / "run"
     args = ["--datasets", "ItalyPowerDemand", "GunPoint", "ArrowHead", "--methods", "dba",
-            "dba-tuned", "rtw-tuned", "1nn-dtw", "--epochs", "2", "--max-series-per-class",
+            "dba-default", "rtw-default", "1nn-dtw", "--epochs", "2", "--max-series-per-class",
             "6", "--halves", "--quiet", "--out", str(out)]  # fmt: skip
     assert main(args) == 0
     records = {
@@ -274,17 +276,16 @@ def test_tuned_rows_share_one_search_and_the_halves_report_adds_up(tmp_path, cap
         for name in ("ArrowHead", "GunPoint", "ItalyPowerDemand")
     }
     for record in records.values():
-        dba, rtw = record["methods"]["dba-tuned"], record["methods"]["rtw-tuned"]
+        dba, rtw = record["methods"]["dba-default"], record["methods"]["rtw-default"]
         assert (dba["dtw_window"], dba["n_centroids"]) == (rtw["dtw_window"], rtw["n_centroids"])
-        assert dba["selection"] == rtw["selection"] and len(dba["selection"]["candidates"]) == 20
+        assert [c["z"] for c in dba["selection"]["candidates"]] == [
+            c["z"] for c in rtw["selection"]["candidates"]
+        ]
+        assert len(dba["selection"]["candidates"]) == 16
         assert rtw["fit_seconds"] >= rtw["selection"]["seconds"] > 0
-        best = max(c["accuracy"] for c in dba["selection"]["candidates"])
-        pick = (dba["dtw_window"], dba["n_centroids"])
-        scores = {
-            (c["dtw_window"], c["n_centroids"]): c["accuracy"]
-            for c in dba["selection"]["candidates"]
-        }
-        assert scores[pick] == best
+        one = record["methods"]["dba"]
+        assert (one["dtw_window"], one["n_centroids"], one["selection"]) == (None, 1, {})
+        assert len(one["output_length"]) == record["n_classes"]
     summary = (out / "summary.md").read_text().split("## Halves")[1]
     assert "Half A: alphabetical positions 1, 3, 5, ... (ArrowHead, ItalyPowerDemand)" in summary
     assert "half B: 2, 4, 6, ... (GunPoint)" in summary
@@ -294,10 +295,14 @@ def test_tuned_rows_share_one_search_and_the_halves_report_adds_up(tmp_path, cap
     )
     assert row.split(" | ")[1] == f"{half_a:.4f} (n=2)"
     pair = next(
-        line for line in summary.splitlines() if line.startswith("| dba-tuned | 1nn-dtw |")
+        line for line in summary.splitlines() if line.startswith("| dba-default | 1nn-dtw |")
     )
     at_least = sum(
-        r["methods"]["dba-tuned"]["accuracy"] >= r["methods"]["1nn-dtw"]["accuracy"]
+        r["methods"]["dba-default"]["accuracy"] >= r["methods"]["1nn-dtw"]["accuracy"]
         for r in records.values()
     )
     assert pair.split(" | ")[4] == f"{at_least} / 3"
+    printed = capsys.readouterr().out
+    default = np.mean([r["methods"]["rtw-default"]["accuracy"] for r in records.values()])
+    assert f"RTWNearestCentroid() (band and centroids per class chosen from the training " \
+        f"data): mean accuracy {default:.4f}" in printed

@@ -3,13 +3,17 @@
 For one dataset and each method:
 
 1. the class means from the training series of each class: ``rtw``, ``ttw``, ``ntw``,
-   ``dba`` are :class:`sk_rtw.RTWNearestCentroid` with that ``method`` (product defaults),
+   ``dba`` are :class:`sk_rtw.RTWNearestCentroid` with that ``method`` and the paper's
+   protocol, one mean per class and no band (``n_centroids=1, dtw_window=None``);
    ``rtw-paper`` is RTW with ``preset="paper"``, ``rtw-equal`` RTW with the paper's
    equal-weight mean (``method=RTW(mean_weights="equal")``), ``rtw-alignment`` RTW with
    ``preset="alignment"`` (align's defaults, means of ``min(N, 4) T``), ``rtw-refined`` the
-   default with ``refine_steps=2`` (soft-DTW refinement of each mean), ``rtw-tuned`` and
-   ``dba-tuned`` with ``n_centroids="auto", dtw_window="auto"``; ``aeon-dba`` is aeon's
-   ``elastic_barycenter_average`` with DTW (a reference where the data are Euclidean);
+   one-mean default with ``refine_steps=2`` (soft-DTW refinement of each mean);
+   ``rtw-default``, ``dba-default``, ``ttw-default``, ``ntw-default`` are the classifier a
+   user gets by default (``RTWNearestCentroid(method=...)``: the band and the centroids
+   per class chosen from the training data, every centroid averaged with the method);
+   ``aeon-dba`` is aeon's ``elastic_barycenter_average`` with DTW (a reference where the
+   data are Euclidean);
 2. averaging values, per training series: ``alignment`` = DTW of the *warped* (aligned)
    series to its class mean (the paper's averaging score; not for aeon's DBA) and
    ``barycenter`` = DTW of the unwarped series to its class mean;
@@ -21,8 +25,9 @@ For one dataset and each method:
    0 wrong; higher is better). A difference is significant when p < alpha; identical
    samples count as no difference.
 
-Every DTW here is sk_rtw's, with the geodesic (absolute) point cost, no window and no
-normalisation -- the paper's accumulated ``D_dtw``.
+Every DTW here is sk_rtw's, with the geodesic (absolute) point cost and no normalisation
+-- the paper's accumulated ``D_dtw`` --, with no window except in the default
+classifiers' predictions (their chosen band).
 """
 
 from __future__ import annotations
@@ -51,35 +56,37 @@ from ._data import load_split, subsample_per_class, take
 ALPHA = 0.05
 #: Result files are readable by everyone (rw-r--r--), like any file the user writes.
 FILE_MODE = 0o644
+#: The paper's protocol (Table II): one mean per class, no band.
+ONE_MEAN = {"n_centroids": 1, "dtw_window": None}
 #: Rows computed by the product's estimator: the method, its settings, the preset, and
 #: other estimator parameters.
-TUNED = {"n_centroids": "auto", "dtw_window": "auto"}
 ESTIMATOR_METHODS: dict[str, tuple[str, dict, str, dict]] = {
-    "rtw": ("rtw", {}, "class-means", {}),
-    "rtw-paper": ("rtw", {}, "paper", {}),
+    "rtw": ("rtw", {}, "class-means", ONE_MEAN),
+    "rtw-paper": ("rtw", {}, "paper", ONE_MEAN),
     # ablations of the class-means preset: the paper's equal-weight mean, and align's
     # defaults (equal weights on the average time axis, 3 start rounds, Z = min(N, 4) T)
-    "rtw-equal": ("rtw", {"mean_weights": "equal"}, "class-means", {}),
-    "rtw-alignment": ("rtw", {}, "alignment", {}),
-    # the default followed by the soft-DTW refinement of each mean (refine_steps=2)
-    "rtw-refined": ("rtw", {"refine_steps": 2}, "class-means", {}),
-    "ttw": ("ttw", {}, "class-means", {}),
-    "ntw": ("ntw", {}, "class-means", {}),
-    "dba": ("dba", {}, "class-means", {}),
-    # the tuned classifier in one line: window and centroids chosen from the training set
-    "rtw-tuned": ("rtw", {}, "class-means", TUNED),
-    "dba-tuned": ("dba", {}, "class-means", TUNED),
+    "rtw-equal": ("rtw", {"mean_weights": "equal"}, "class-means", ONE_MEAN),
+    "rtw-alignment": ("rtw", {}, "alignment", ONE_MEAN),
+    # the one-mean default followed by the soft-DTW refinement of each mean
+    "rtw-refined": ("rtw", {"refine_steps": 2}, "class-means", ONE_MEAN),
+    "ttw": ("ttw", {}, "class-means", ONE_MEAN),
+    "ntw": ("ntw", {}, "class-means", ONE_MEAN),
+    "dba": ("dba", {}, "class-means", ONE_MEAN),
+    # the classifier a user gets by default: band and centroids per class chosen from
+    # the training data (RTWNearestCentroid(), and with method="dba", "ttw", "ntw")
+    "rtw-default": ("rtw", {}, "class-means", {}),
+    "dba-default": ("dba", {}, "class-means", {}),
+    "ttw-default": ("ttw", {}, "class-means", {}),
+    "ntw-default": ("ntw", {}, "class-means", {}),
 }
+#: Rows of the classifier a user gets by default.
+DEFAULT_CLASSIFIERS = tuple(m for m in ESTIMATOR_METHODS if m.endswith("-default"))
 REFERENCE_METHODS = ("aeon-dba", "1nn-dtw")
 ALL_METHODS = (*ESTIMATOR_METHODS, *REFERENCE_METHODS)
-#: The default rows (``rtw-paper`` is slow: means of length N T with the network at every
-#: time point; the ablations and the tuned rows on demand; ask for them with ``--methods``).
-DEFAULT_METHODS = tuple(
-    m
-    for m in ALL_METHODS
-    if m
-    not in ("rtw-paper", "rtw-equal", "rtw-alignment", "rtw-refined", "rtw-tuned", "dba-tuned")
-)
+#: The main job's rows: the paper's one-mean comparison, the default classifier and the
+#: references (``rtw-paper`` is slow: means of length N T with the network at every time
+#: point; the ablations and the other default classifiers on demand, with ``--methods``).
+DEFAULT_METHODS = ("rtw", "ttw", "ntw", "dba", "rtw-default", "aeon-dba", "1nn-dtw")
 
 
 @dataclass(frozen=True)
@@ -132,29 +139,12 @@ def make_estimator(row: str, config: RunConfig) -> RTWNearestCentroid:
     )
 
 
-def _fit_estimator(method, train, test, config, selections):
-    """Fit one estimator row; ``selections`` shares the "auto" choices between rows.
-
-    Every tuned row scores its candidates with the same DBA proxy, folds and seed, so the
-    second tuned row of a dataset reuses the first one's choice (identical by construction)
-    instead of repeating the search; its fit time still includes the search's seconds.
-    """
+def _fit_estimator(method, train, test, config):
+    """Fit one estimator row; its scores, predictions and times."""
     estimator = make_estimator(method, config)
-    shared = selections.get("auto") if ESTIMATOR_METHODS[method][3] == TUNED else None
-    if shared is not None:
-        estimator.set_params(dtw_window=shared["dtw_window"], n_centroids=shared["n_centroids"])
     start = time.perf_counter()
     estimator.fit(train.X, train.y)
     fit_seconds = time.perf_counter() - start
-    if shared is not None:
-        fit_seconds += shared["selection"]["seconds"]
-        estimator.selection_ = shared["selection"]
-    elif ESTIMATOR_METHODS[method][3] == TUNED:
-        selections["auto"] = {
-            "dtw_window": estimator.dtw_window_,
-            "n_centroids": estimator.n_centroids_,
-            "selection": estimator.selection_,
-        }
     alignment = np.full(len(train.y), np.nan)
     barycenter = np.full(len(train.y), np.nan)
     for k, fitted in enumerate(estimator.alignments_):  # every centroid and its series
@@ -181,7 +171,7 @@ def _fit_estimator(method, train, test, config, selections):
         ],
         "dtw_window": estimator.dtw_window_,
         "n_centroids": estimator.n_centroids_,
-        "selection": getattr(estimator, "selection_", None),
+        "selection": estimator.selection_,
         "iterations": [a.n_iter for a in estimator.alignments_],
         "output_length": [len(m) for m in estimator.means_],
     }
@@ -326,7 +316,6 @@ def _process_dataset(name, config, position, on_method_done) -> dict:
             train_index=kept,
         )
         train = take(train, kept)
-        selections: dict = {}  # the "auto" choices, made once per dataset
         for method in config.methods:
             elapsed = time.perf_counter() - start
             if config.time_budget and elapsed > config.time_budget:
@@ -338,7 +327,7 @@ def _process_dataset(name, config, position, on_method_done) -> dict:
             _log(config, f"{position} {name}: {method} ...")
             try:
                 if method in ESTIMATOR_METHODS:
-                    out = _fit_estimator(method, train, test, config, selections)
+                    out = _fit_estimator(method, train, test, config)
                 elif method == "aeon-dba":
                     out = _fit_aeon_dba(train, test, config)
                 elif method == "1nn-dtw":
