@@ -195,7 +195,7 @@ def section_classify(demo_dir: str | None, epochs: int) -> None:
             fit = time.perf_counter() - start
             accuracy = clf.score([X[i] for i in test], y[test])
             choice = "" if params else f"w={clf.dtw_window_},k={clf.n_centroids_}"
-            cells.append(f"{accuracy:.3f} {choice} {fit:.0f}s")
+            cells.append(f"{accuracy:.3f} {choice} {fit:.1f}s")
         nearest = dtw_pairwise_distance([X[i] for i in test], [X[i] for i in train],
                                         manifold=clf.manifold_).argmin(1)  # fmt: skip
         one_nn = float((y[train][nearest] == y[test]).mean())
