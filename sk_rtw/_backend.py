@@ -23,10 +23,12 @@ def to_tensor(x: Any, like: torch.Tensor | None = None) -> torch.Tensor:
         if like is not None and (x.dtype != like.dtype or x.device != like.device):
             x = x.to(dtype=like.dtype, device=like.device)
         return x
-    arr = np.asarray(x)
+    arr = np.ascontiguousarray(x)
     if arr.dtype.kind not in "f":
         arr = arr.astype(np.float64)
-    t = torch.from_numpy(np.ascontiguousarray(arr))
+    if not arr.flags.writeable:  # torch shares memory only with writable arrays
+        arr = arr.copy()
+    t = torch.from_numpy(arr)
     if like is not None:
         t = t.to(dtype=like.dtype, device=like.device)
     return t

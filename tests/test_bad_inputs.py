@@ -8,6 +8,7 @@ import warnings
 import numpy as np
 import pandas as pd
 import pytest
+import torch
 from sklearn.exceptions import ConvergenceWarning, NotFittedError
 
 from sk_rtw import (
@@ -25,6 +26,7 @@ from sk_rtw import (
 )
 from sk_rtw.baselines import dba_average, mmddtw_align
 from sk_rtw.datasets import make_warped_signals
+from sk_rtw.manifolds import Manifold, ManifoldCheckError, check_manifold
 from sk_rtw.utils import from_aeon, from_tslearn, to_aeon
 
 from .conftest import MANIFOLDS, quick
@@ -530,3 +532,120 @@ def test_an_object_array_of_unequal_series_reads_like_the_list():
     for a, b in zip(from_list.means_, from_array.means_, strict=True):
         np.testing.assert_array_equal(a, b)
     np.testing.assert_array_equal(from_array.predict(packed), [0, 0, 1, 1])
+
+
+# ---------------------------------------------------------- defects found by use (31)
+class _Line(Manifold):
+    """R^d written by hand: the base of the broken spaces below."""
+
+    def __init__(self, dim: int = 1):
+        self.dim = dim
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}({self.dim})"
+
+    def __eq__(self, other) -> bool:
+        return type(self) is type(other) and self.dim == other.dim
+
+    def __hash__(self) -> int:
+        return hash((type(self), self.dim))
+
+    @property
+    def point_shape(self):
+        return (self.dim,)
+
+    def _exp(self, p, v):
+        return p + v
+
+    def _log(self, p, x):
+        return x - p
+
+
+class DoubleStep(_Line):
+    """exp(p, v) = p + 2 v does not invert log(p, x) = x - p."""
+
+    def _exp(self, p, v):
+        return p + 2 * v
+
+
+class ShortSighted(_Line):
+    """log is NaN beyond a distance of 0.5."""
+
+    def _log(self, p, x):
+        v = x - p
+        return torch.where(v.abs() > 0.5, torch.full_like(v, float("nan")), v)
+
+
+class ShapeLying(_Line):
+    """Declares points of shape (3,), returns 2-vectors."""
+
+    @property
+    def point_shape(self):
+        return (3,)
+
+    def _exp(self, p, v):
+        return (p + v)[..., :2]
+
+    def _log(self, p, x):
+        return (x - p)[..., :2]
+
+
+def smooth_series(n=4, length=25, offset=0.0, seed=0):
+    rng = np.random.default_rng(seed)
+    t = np.linspace(0, 1, length)
+    return np.stack([np.sin(2 * np.pi * t ** rng.uniform(0.8, 1.2)) * 0.2 + offset
+                     for _ in range(n)])[..., None]  # fmt: skip
+
+
+def test_a_manifold_whose_exp_does_not_invert_log_is_refused_before_any_work():
+    X = smooth_series()
+    for call in (
+        lambda: align(X, manifold=DoubleStep(), n_epochs=2),
+        lambda: RTWNearestCentroid(manifold=DoubleStep(), method="dba").fit(X, [0, 0, 1, 1]),
+        lambda: dba_average(X, manifold=DoubleStep()),
+    ):
+        with pytest.raises(ValueError, match=r"exp must invert log.*check_manifold"):
+            call()
+    # the package's own spaces are not re-checked; a correct space of one's own passes
+    result = align(X, manifold=_Line(), n_epochs=2, random_state=0)
+    assert np.isfinite(result.mean).all()
+
+
+def test_non_finite_point_costs_are_an_error_naming_the_manifold_and_the_samples():
+    x = np.linspace(0, 2, 10)[:, None]  # neighbouring samples 0.22 apart: log is fine there
+    with pytest.raises(ValueError, match=r"ShortSighted\(1\) gives the distance nan between "
+                       r"x at time 0 and y at time 0"):  # fmt: skip
+        dtw_distance(x, x[::-1], manifold=ShortSighted())
+    with pytest.raises(ValueError, match=r"between X\[0\] at time 0 and Y\[0\] at time 3"):
+        dtw_pairwise_distance([x], [x, x[::-1]], manifold=ShortSighted())
+    # aligning or averaging such series says the same, not "the window is too narrow"
+    X = np.stack([x[:, 0], x[::-1, 0], x[:, 0]])[..., None]
+    for call in (
+        lambda: align(X, manifold=ShortSighted(), n_epochs=2),
+        lambda: RTWNearestCentroid(manifold=ShortSighted(), method="dba").fit(X, [0, 0, 1]),
+    ):
+        with pytest.raises(ValueError, match="non-finite point costs") as info:
+            call()
+        assert "window" not in str(info.value).split("DTW needs")[0]
+
+
+def test_a_manifold_that_lies_about_its_point_shape_is_named():
+    X = np.zeros((3, 10, 3)) + np.linspace(0, 1, 10)[:, None]
+    with pytest.raises(ValueError, match=r"shape \(2,\) for points of shape \(3,\).*point_shape"):
+        align(X, manifold=ShapeLying(), n_epochs=2)
+    with pytest.raises(ManifoldCheckError, match=r"exp and log keep the point shape.*point_shape"):
+        check_manifold(ShapeLying(), X[0, :4])
+
+
+def test_check_manifold_names_log_when_it_fails_during_set_up():
+    points = np.linspace(0, 3, 5)[:, None]  # far apart: log is NaN between them
+    with pytest.raises(ManifoldCheckError, match=r"tangent vectors at the points.*log"):
+        check_manifold(ShortSighted(), points)
+
+
+def test_read_only_arrays_reach_torch_without_a_warning():
+    p = Sphere(2).random_point(4, random_state=0)
+    p.flags.writeable = False
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        np.testing.assert_allclose(Sphere(2).log(p, p), 0.0, atol=1e-12)

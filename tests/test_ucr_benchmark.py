@@ -304,5 +304,7 @@ def test_default_rows_make_the_same_choice_and_the_halves_report_adds_up(tmp_pat
     assert pair.split(" | ")[4] == f"{at_least} / 3"
     printed = capsys.readouterr().out
     default = np.mean([r["methods"]["rtw-default"]["accuracy"] for r in records.values()])
-    assert f"RTWNearestCentroid() (band and centroids per class chosen from the training " \
+    assert (
+        f"RTWNearestCentroid() (band and centroids per class chosen from the training "
         f"data): mean accuracy {default:.4f}" in printed
+    )

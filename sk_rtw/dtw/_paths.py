@@ -32,6 +32,8 @@ def optimal_path(cost: np.ndarray, window: float = -1.0) -> tuple[np.ndarray, fl
     """
     D = _kernels.accumulated_cost(cost, window)
     if not np.isfinite(D[-1, -1]):
+        if window < 0.0 or not np.isfinite(cost).all():
+            raise ValueError(f"the DTW cost is {D[-1, -1]}: the point costs are not finite")
         raise ValueError("the Sakoe–Chiba window is too narrow to connect the series ends")
     return np.asarray(_kernels.backtrack(D), dtype=np.int64).reshape(-1, 2), float(D[-1, -1])
 

@@ -261,12 +261,14 @@ def _check_labels(y: Any, n_series: int, classification: bool) -> np.ndarray:
         for i, value in enumerate(labels.tolist()):
             if value is None or (isinstance(value, float) and np.isnan(value)):
                 raise ValueError(f"y[{i}] is {value!r}: labels must not be missing (None or NaN)")
+    if labels.dtype.kind == "f" and not np.isfinite(labels).all():  # before any cast
+        first = int(np.argmax(~np.isfinite(labels)))
+        raise ValueError(
+            f"y[{first}] is {labels[first]}: labels must not be missing (NaN) or infinite"
+        )
     mixed = labels.dtype == object and len({type(v) for v in labels.tolist()}) > 1
     if classification and not mixed:  # scikit-learn cannot sort mixed str/int labels
         check_classification_targets(labels)
-    elif labels.dtype.kind == "f" and np.isnan(labels).any():
-        first = int(np.argmax(np.isnan(labels)))
-        raise ValueError(f"y[{first}] is NaN: labels must not be missing")
     return labels
 
 

@@ -105,9 +105,33 @@ def check_manifold(
     p, q = points, np.roll(points, 1, axis=0)
     radius = M.injectivity_radius
     half = 0.5 * radius if math.isfinite(radius) else 1.0
-    vectors = _tangents(M, p, q, rng)
-    norms = np.asarray(M.norm(p, vectors)).reshape(-1, *([1] * nd))
-    small = vectors / np.where(norms > 0, norms, 1.0) * half * rng.uniform(0.2, 1.0, norms.shape)
+    if p.shape[1:] != M.point_shape:
+        raise ValueError(
+            f"points have shape {p.shape[1:]} each, but {M!r} has point_shape {M.point_shape}"
+        )
+
+    def shapes():
+        for what, out in (("log(p, q)", M.log(p, q)), ("exp(p, 0)", M.exp(p, np.zeros_like(p)))):
+            shape = np.shape(out)
+            if shape != p.shape:
+                _fail(M, "exp and log keep the point shape", f"{what} has shape {shape[1:]} per "
+                      f"point where point_shape is {M.point_shape}")  # fmt: skip
+
+    check("exp and log keep the point shape", shapes)
+    setup: dict[str, np.ndarray] = {}
+
+    def tangent_vectors():
+        vectors = np.asarray(_tangents(M, p, q, rng))
+        if not np.isfinite(vectors).all():
+            _fail(M, "tangent vectors at the points", "log (or random_tangent) returns NaN or "
+                  "infinite values between the given points")  # fmt: skip
+        norms = np.asarray(M.norm(p, vectors)).reshape(-1, *([1] * nd))
+        scale = half * rng.uniform(0.2, 1.0, norms.shape)
+        setup["vectors"] = vectors
+        setup["small"] = vectors / np.where(norms > 0, norms, 1.0) * scale
+
+    check("tangent vectors at the points", tangent_vectors)
+    vectors, small = setup["vectors"], setup["small"]
 
     check("points validate", lambda: M.validate(p))
     check("exp(p, 0) = p", lambda: _close(M, "exp(p, 0) = p", M.exp(p, np.zeros_like(p)), p, atol))
@@ -201,7 +225,85 @@ def _tangents(M: Manifold, p: np.ndarray, q: np.ndarray, rng) -> np.ndarray:
         return np.asarray(M.random_tangent(p, 1.0, random_state=rng))
     except NotImplementedError:
         v = np.asarray(M.log(p, q))
+        if not np.isfinite(v).all():
+            _fail(M, "tangent vectors at the points", "log returns NaN or infinite values "
+                  "between the given points")  # fmt: skip
         zero = np.asarray(M.norm(p, v)) == 0
         if np.any(zero):  # coincident neighbours: use the next point instead
             v[zero] = np.asarray(M.log(p[zero], np.roll(p, 2, axis=0)[zero]))
         return v
+
+
+#: Relative tolerance of :func:`check_on_data`'s round trip ``exp(p, log(p, x)) = x``.
+ROUND_TRIP_RTOL = 1e-6
+#: Manifolds of the user's that passed :func:`check_on_data` (checked once each).
+_PASSED: set = set()
+
+
+def shipped(manifold: Manifold) -> bool:
+    """Whether ``manifold`` is one of the package's spaces (tested by its own suite)."""
+    return type(manifold).__module__.startswith("sk_rtw.manifolds.")
+
+
+def check_on_data(manifold: Manifold, series: list[np.ndarray], name: str = "X") -> None:
+    """A quick check of a space the package does not ship, on a few of the user's samples.
+
+    The first time a manifold of your own meets data, ``exp`` and ``log`` are checked at
+    up to 12 pairs of neighbouring samples of the first series: shapes (the point shape),
+    finite values, ``log(p, p) = 0`` and the round trip ``exp(p, log(p, x)) = x``. A
+    space that fails is refused before any work with a ``ValueError`` naming the property;
+    :func:`check_manifold` checks the whole contract.
+    """
+    if shipped(manifold):
+        return
+    try:
+        if manifold in _PASSED:
+            return
+    except TypeError:  # an unhashable space is checked every time (it is cheap)
+        pass
+    pairs = []
+    for s in series[:3]:
+        if len(s) < 2:
+            continue
+        at = np.unique(np.linspace(0, len(s) - 2, 4).astype(int))
+        pairs += [(s[t], s[t + 1]) for t in at]
+    if not pairs:
+        return
+    p = np.stack([a for a, _ in pairs]).astype(np.float64)
+    x = np.stack([b for _, b in pairs]).astype(np.float64)
+    hint = f"; sk_rtw.check_manifold({manifold!r}, points) checks the whole contract"
+
+    def refuse(problem: str) -> None:
+        raise ValueError(f"{manifold!r} cannot be used on {name}: {problem}{hint}")
+
+    def computed(what: str, fn) -> np.ndarray:
+        try:
+            out = np.asarray(fn())
+        except Exception as exc:
+            refuse(f"{what} fails on its samples ({type(exc).__name__}: {exc})")
+        if out.shape != p.shape:
+            refuse(
+                f"{what} returns arrays of shape {out.shape[1:]} for points of shape "
+                f"{p.shape[1:]} (point_shape is {manifold.point_shape}): exp and log must "
+                "return arrays of the point shape"
+            )
+        if not np.isfinite(out).all():
+            refuse(f"{what} returns NaN or infinite values at neighbouring samples")
+        return out
+
+    v = computed("log(p, x)", lambda: manifold.log(p, x))
+    zero = computed("log(p, p)", lambda: manifold.log(p, p))
+    back = computed("exp(p, log(p, x))", lambda: manifold.exp(p, v))
+    scale = 1.0 + float(np.abs(x).max())
+    if np.abs(zero).max() > ROUND_TRIP_RTOL * scale:
+        refuse(f"log(p, p) is not 0 (largest entry {np.abs(zero).max():.3g})")
+    error = float(np.abs(back - x).max())
+    if error > ROUND_TRIP_RTOL * scale:
+        refuse(
+            f"exp(p, log(p, x)) differs from x by up to {error:.3g} for neighbouring samples "
+            "p, x: exp must invert log, or the aligned series and their mean are wrong"
+        )
+    try:
+        _PASSED.add(manifold)
+    except TypeError:
+        pass

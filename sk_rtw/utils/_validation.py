@@ -24,6 +24,7 @@ from scipy.sparse import issparse
 from sklearn.utils import check_array
 
 from ..manifolds import Manifold, get_manifold
+from ..manifolds._check import check_on_data
 
 #: Relative tolerance used to decide whether data lie on the manifold.
 DEFAULT_ATOL = 1e-6
@@ -356,6 +357,7 @@ def _check_content(
                 f"{where} contains NaN or infinite values; missing values are not supported "
                 "(impute or drop them first)"
             )
+    check_on_data(manifold, series, name)
     stacked_label = name if single else f"{name}[series, time]"
     if single:
         manifold.validate(series[0], atol=atol, name=stacked_label)
