@@ -649,3 +649,75 @@ def test_read_only_arrays_reach_torch_without_a_warning():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         np.testing.assert_allclose(Sphere(2).log(p, p), 0.0, atol=1e-12)
+
+
+def test_a_network_too_large_for_memory_names_hidden_size_before_any_allocation():
+    with pytest.raises(MemoryError, match=r"hidden_size=100000.*lower hidden_size"):
+        align(UNI[:3], hidden_size=10**5, n_epochs=1)
+
+
+def test_wide_sinc_windows_and_smoothing_are_bounded_by_the_series(monkeypatch):
+    """A sinc window wider than the series reads no more data; a smoothing kernel never
+    exceeds the series: both finish at once (were 129 s and a 4.5 GiB allocation)."""
+    import time
+
+    X = UNI[:3]  # 20 samples
+    start = time.perf_counter()
+    wide = align(X, sinc_window=10**6, n_epochs=3, random_state=0)
+    assert wide.config.sinc_window == 20  # what ran
+    capped = align(X, sinc_window=20, n_epochs=3, random_state=0)
+    np.testing.assert_array_equal(wide.mean, capped.mean)
+    smooth = align(X, smoothing=1e8, n_epochs=3, random_state=0)
+    assert np.isfinite(smooth.mean).all()
+    assert time.perf_counter() - start < 20
+
+
+def test_refinement_stops_when_the_cost_stops_falling():
+    import time
+
+    X = UNI[:4]
+    start = time.perf_counter()
+    many = align(X, refine_steps=10**4, n_epochs=2, random_state=0)
+    assert time.perf_counter() - start < 20
+    few = align(X, refine_steps=200, n_epochs=2, random_state=0)
+    np.testing.assert_array_equal(many.mean, few.mean)  # both stopped at the same step
+
+
+def test_a_method_given_by_name_is_searchable_through_its_settings():
+    from sklearn.model_selection import GridSearchCV
+
+    search = GridSearchCV(
+        RTWNearestCentroid(n_centroids=1, dtw_window=None), {"method__n_epochs": [1, 2]}, cv=2
+    ).fit(UNI, LABELS)
+    assert search.best_estimator_.method.get_params()["n_epochs"] in (1, 2)
+    assert RTWNearestCentroid(method="ttw").set_params(method__n_epochs=3).method.name == "ttw"
+
+
+def test_set_params_says_where_a_setting_belongs():
+    with pytest.raises(ValueError, match=r"n_epochs.*method=RTW\(n_epochs=\.\.\.\)"):
+        RTWNearestCentroid().set_params(n_epochs=5)
+    from sk_rtw import RTWKMeans
+
+    with pytest.raises(ValueError, match="method__hidden_size"):
+        RTWKMeans().set_params(hidden_size=5)
+
+
+def test_a_long_format_table_is_explained():
+    table = pd.DataFrame({"series": np.repeat(np.arange(6), 20), "time": np.tile(np.arange(20), 6),
+                          "value": RNG.standard_normal(120)})  # fmt: skip
+    with pytest.raises(ValueError, match=r"120 series but y has 6 labels.*long-format.*pivot"):
+        RTWNearestCentroid(method="dba").fit(table, LABELS)
+
+
+def test_align_points_dba_to_its_own_function():
+    with pytest.raises(ValueError, match=r"dba_average"):
+        align(UNI[:3], method="dba")
+
+
+def test_an_early_stop_is_announced_with_the_epoch_kept(capsys):
+    result = align(QUAT, manifold="quaternion", verbose=True, random_state=0,
+                   n_iter_no_change=3, n_epochs=200)  # fmt: skip
+    err = capsys.readouterr().err
+    assert result.n_iter < 200
+    assert f"stopped early after {result.n_iter} of 200 epochs: 3 epochs without" in err
+    assert f"keeping the warps of epoch {result.best_epoch} (best_epoch" in err

@@ -16,6 +16,7 @@ from collections.abc import Mapping
 from dataclasses import asdict, dataclass, fields
 from typing import Any
 
+import numpy as np
 import torch
 
 from ..utils._params import AUTO, InstanceOf, Options, Parameter
@@ -213,6 +214,9 @@ def resolve_config(
     values = resolve_knobs(method, preset, explicit)
     if values["output_length"] is None:
         values["output_length"] = PRESETS[preset].output_length(lengths)
+    longest = int(np.max(lengths))
+    if values.get("sinc_window") is not None and values["sinc_window"] > longest:
+        values["sinc_window"] = longest  # a window wider than the series reads no more data
     if given_start:
         values["warp_start"] = "given"
     # the knobs; those of other methods (TTW's network, RTW's sine terms) are None

@@ -11,6 +11,7 @@ early stop).
 from __future__ import annotations
 
 import inspect
+import sys
 import time
 from dataclasses import dataclass, field
 from typing import Any
@@ -41,7 +42,7 @@ from ._loss import window_weights
 from ._refine import refine_mean
 from ._sinc import TABLE_BYTES, SincInterpolator
 from ._start import dtw_start
-from ._training import Trainer, progress_printer
+from ._training import Trainer, early_stop_note, progress_printer
 from ._warps import NeuralWarps, SineWarps, WarpModel, compose_warps, unit_time
 
 
@@ -239,6 +240,11 @@ def align(
     knobs below) defaults to ``"auto"``, the preset's value, resolved as in the
     estimators: the same preset gives the same configuration for the same series.
 
+    The length of the mean and of the aligned series, ``Z`` (``output_length``), is by
+    default ``min(N, 4) T_max`` (the ``"alignment"`` preset: the paper's ``N T_max`` up
+    to 4 series, then linear in ``N``); ``preset="paper"`` gives ``N T_max``, and
+    ``preset="class-means"`` the median length of the series.
+
     Parameters
     ----------
     X : array-like or list of array-like
@@ -269,6 +275,14 @@ def align(
     >>> align(X, preset="paper", n_epochs=2).mean.shape  # Z = N T_max
     (150, 1)
     """
+    if (isinstance(method, str) and method.lower() == "dba") or getattr(
+        method, "name", ""
+    ) == "dba":
+        raise ValueError(
+            'align runs the engine\'s methods ("rtw", "ttw", "ntw"); DBA has its own '
+            "function: sk_rtw.baselines.dba_average(X, manifold=...), or "
+            'RTWNearestCentroid(method="dba") for class means'
+        )
     method = ALIGN_METHOD.check(method)
     if not isinstance(method, str):  # a method object: its settings, then the keywords
         settings = {**method.settings(), **settings}
@@ -369,9 +383,9 @@ def align_collection(
     list of Alignment
         One per group, in group order.
     """
-    check_memory(collection, config)
-    start_time = time.perf_counter()
     layout = GroupLayout.from_codes(codes)
+    check_memory(collection, config, layout.n_groups)
+    start_time = time.perf_counter()
     if len(seeds) != layout.n_groups:
         raise ValueError(f"{len(seeds)} seeds for {layout.n_groups} groups")
     rngs = [np.random.default_rng(int(seed)) for seed in seeds]
@@ -465,7 +479,9 @@ def _finite(values: torch.Tensor, collection: SeriesCollection, what: str) -> to
     return values
 
 
-def estimated_memory(collection: SeriesCollection, config: AlignmentConfig) -> int:
+def estimated_memory(
+    collection: SeriesCollection, config: AlignmentConfig, n_groups: int = 1
+) -> int:
     """Rough peak bytes of an alignment: activations kept for the backward pass.
 
     Per output point and series: the interpolated point and its derivative, the
@@ -483,19 +499,39 @@ def estimated_memory(collection: SeriesCollection, config: AlignmentConfig) -> i
     times = z if config.warp_knots is None else min(z, config.warp_knots)
     width = config.hidden_size or 0  # TTW's sine warps have no network
     network = 8 * 3 * times * (2 * width + 1 + n_series) + 8 * 4 * z * n_series
-    return n_series * z * per_point + table + network
+    parameters = network_memory(config, n_series, n_groups)
+    return n_series * z * per_point + table + network + parameters
 
 
-def check_memory(collection: SeriesCollection, config: AlignmentConfig) -> None:
+def network_memory(config: AlignmentConfig, n_series: int, n_groups: int = 1) -> int:
+    """Bytes of the warp networks' weights with their gradients and Adam's two moments:
+    one 1-H-H-(2H+1)-(N_g-1) network per group, about ``H^2 + 2 H N`` weights in all
+    (none for TTW)."""
+    width = config.hidden_size or 0
+    per_group = width * width + 5 * width
+    weights = n_groups * per_group + (2 * width + 1) * max(n_series - n_groups, 0)
+    return 8 * 4 * weights
+
+
+def check_memory(collection: SeriesCollection, config: AlignmentConfig, n_groups: int = 1) -> None:
     """``MemoryError`` naming the sizes when an alignment cannot fit in memory."""
-    need, free = estimated_memory(collection, config), available_memory()
-    if need > free:
+    need, free = estimated_memory(collection, config, n_groups), available_memory()
+    if need <= free:
+        return
+    network = network_memory(config, collection.n_series, n_groups)
+    if network > need / 2:
         raise MemoryError(
-            f"aligning {collection.n_series} series to output_length Z={config.output_length} "
-            f"needs about {format_bytes(need)}, more than the {format_bytes(free)} of memory "
-            "available: lower output_length (the paper preset uses N T_max), align fewer "
-            "series at once, or use warp_knots"
+            f"the warp network of hidden_size={config.hidden_size} for "
+            f"{collection.n_series} series needs about {format_bytes(network)} for its "
+            f"weights and their optimiser state, more than the {format_bytes(free)} of "
+            "memory available: lower hidden_size (the paper's is 512)"
         )
+    raise MemoryError(
+        f"aligning {collection.n_series} series to output_length Z={config.output_length} "
+        f"needs about {format_bytes(need)}, more than the {format_bytes(free)} of memory "
+        "available: lower output_length (the paper preset uses N T_max), align fewer "
+        "series at once, or use warp_knots"
+    )
 
 
 def _check_warps(warps: Any, n_signals: int, output_length: int | None) -> np.ndarray:
@@ -547,5 +583,9 @@ def _optimise(
     report, every = progress_printer(config.method, config.n_epochs, verbose)
     best_epoch = trainer.run(report, every)
     done = trainer.epochs_done
+    note = early_stop_note(config.method, done, config.n_epochs, best_epoch,
+                           config.n_iter_no_change, config.tol)  # fmt: skip
+    if verbose and note:
+        print(note, file=sys.stderr, flush=True)
     history[:done] = trainer.history[:done].cpu().numpy()
     return best_epoch, trainer.epochs_run.cpu().numpy()

@@ -40,6 +40,9 @@ GAMMAS = (0.03, 0.01)
 #: Soft alignment weights below this fraction of a row's largest are left out of the
 #: mean on curved manifolds (they would not move it).
 WEIGHT_FLOOR = 1e-6
+#: A temperature's steps stop once a step lowers the hard DTW cost by less than this
+#: fraction (DBA's rule): ``refine_steps`` is a most, not a count to run.
+TOL = 1e-4
 
 
 @dataclass(frozen=True)
@@ -77,7 +80,8 @@ def refine_mean(
         The start (its length is kept).
     manifold : Manifold
     steps : int
-        Majorisation steps at each temperature of ``gammas``.
+        Most majorisation steps at each temperature of ``gammas``; a temperature stops
+        at the first step that lowers the hard DTW cost by less than :data:`TOL`.
     gammas : tuple of float
         Temperatures relative to the mean squared path cost per sample of the start.
     window : float or None
@@ -101,9 +105,10 @@ def refine_mean(
     padded = np.zeros((len(series), lengths.max(), *best.shape[1:]))
     for n, s in enumerate(series):
         padded[n, : len(s)] = s
-    current = best
+    current, cost = best, best_cost
     for gamma in gammas:
         for _ in range(steps):
+            previous = cost
             costs = np.zeros((len(series), len(current), lengths.max()))
             joint = point_cost_matrix(current, stacked, manifold, squared=True)
             for n, part in enumerate(np.split(joint, ends[:-1], axis=1)):
@@ -115,6 +120,8 @@ def refine_mean(
             cost = _hard_cost(series, current, manifold, window)
             if cost < best_cost:
                 best, best_cost = current, cost
+            if previous - cost <= TOL * previous:  # the cost stopped falling
+                break
     return Refinement(best, start_cost, best_cost, done)
 
 

@@ -85,7 +85,8 @@ SMOOTHING = 2.0
 
 def _smooth_monotone(warp: np.ndarray, sigma: float) -> np.ndarray:
     """Gaussian smoothing that keeps a warp non-decreasing and its ends at 0 and 1."""
-    radius = int(np.ceil(3 * sigma))
+    # the kernel never exceeds the warp: beyond its length it would only flatten it more
+    radius = min(int(np.ceil(3 * sigma)), len(warp) - 1)
     offsets = np.arange(-radius, radius + 1)
     kernel = np.exp(-0.5 * (offsets / sigma) ** 2)
     # odd reflection about the ends keeps the end values and the monotonicity

@@ -232,7 +232,10 @@ class Trainer:
 
 
 def progress_printer(method: str, n_epochs: int, verbose: bool | int):
-    """The ``report`` callback of :meth:`Trainer.run` and its interval for ``verbose``."""
+    """The ``report`` callback of :meth:`Trainer.run` and its interval for ``verbose``.
+
+    Epochs are numbered from 0, as ``Alignment.best_epoch`` is.
+    """
     every = (
         int(verbose) if not isinstance(verbose, bool) and verbose > 1 else max(1, n_epochs // 10)
     )
@@ -246,10 +249,28 @@ def progress_printer(method: str, n_epochs: int, verbose: bool | int):
         best = int(np.argmin(total)) if np.isfinite(total).any() else 0
         groups = f", {running}/{history.shape[1]} groups running" if history.shape[1] > 1 else ""
         print(
-            f"[{method}] epoch {done:>4}/{n_epochs} loss {total[-1]:.6g} "
-            f"(best {total[best]:.6g} at {best + 1}){groups}",
+            f"[{method}] {done:>4}/{n_epochs} epochs, loss {total[-1]:.6g} "
+            f"(best {total[best]:.6g} at epoch {best}){groups}",
             file=sys.stderr,
             flush=True,
         )
 
     return report, every
+
+
+def early_stop_note(
+    method: str, done: int, n_epochs: int, best_epoch: np.ndarray, n_iter_no_change, tol
+) -> str | None:
+    """The ``verbose`` line of a run that stopped before ``n_epochs``, or None."""
+    if done >= n_epochs or n_iter_no_change is None:
+        return None
+    kept = (
+        f"epoch {int(best_epoch[0])}"
+        if len(best_epoch) == 1
+        else f"each group's best epoch ({int(best_epoch.min())} to {int(best_epoch.max())})"
+    )
+    return (
+        f"[{method}] stopped early after {done} of {n_epochs} epochs: {n_iter_no_change} "
+        f"epochs without a relative gain of tol={tol}; keeping the warps of {kept} "
+        "(best_epoch, numbered from 0)"
+    )

@@ -16,7 +16,12 @@ from ..methods import FitContext, get_method
 from ..utils import check_series_collection
 from ..utils._params import declare_parameters, validate_parameters
 from ._core import _label, fit_centroids
-from ._params import AVERAGER_DEFAULTS, AVERAGER_PARAMETERS, setting_hint
+from ._params import (
+    AVERAGER_DEFAULTS,
+    AVERAGER_PARAMETERS,
+    set_params_with_hints,
+    setting_hint,
+)
 from ._selection import choose, partition
 
 
@@ -93,6 +98,23 @@ class RTWAverager(TransformerMixin, BaseEstimator):
     >>> RTWAverager(method="dba").fit(X, [0, 0, 1, 1]).means_.shape
     (2, 40, 1)
     """
+
+    def set_params(self, **params):
+        """Set parameters, scikit-learn's way; ``method__<setting>`` also works when
+        ``method`` is a name (it becomes the method's object), and a setting that is no
+        parameter says where it belongs.
+
+        Parameters
+        ----------
+        **params : dict
+            Estimator parameters, and ``method__<setting>`` for the method's settings.
+
+        Returns
+        -------
+        self
+        """
+        set_params_with_hints(self, params, super().set_params)
+        return self
 
     # ------------------------------------------------------------------ fit
     def fit(self, X: Any, y: Any = None):
@@ -256,7 +278,12 @@ def _check_labels(y: Any, n_series: int, classification: bool) -> np.ndarray:
         y = np.array(y, dtype=object)  # keep mixed str/number labels as they are
     labels = column_or_1d(y, warn=True)
     if len(labels) != n_series:
-        raise ValueError(f"X has {n_series} series but y has {len(labels)} labels")
+        raise ValueError(
+            f"X has {n_series} series but y has {len(labels)} labels: X holds one series per "
+            "row, (n_series, n_timepoints[, *point_shape]), or is a list of series; a "
+            "long-format table (one row per sample) must be pivoted first, e.g. "
+            "df.pivot(index='series', columns='time', values='value')"
+        )
     if labels.dtype == object:
         for i, value in enumerate(labels.tolist()):
             if value is None or (isinstance(value, float) and np.isnan(value)):

@@ -15,7 +15,15 @@ from ..utils import check_series_collection
 from ..utils._common_params import DTW_WINDOW, MANIFOLD, N_JOBS, RANDOM_STATE, VERBOSE
 from ..utils._params import declare_parameters, validate_parameters
 from ._core import dtw_to_centroids, kmeans
-from ._params import MAX_ITER, METHOD, N_CLUSTERS, N_INIT, TOL, setting_hint
+from ._params import (
+    MAX_ITER,
+    METHOD,
+    N_CLUSTERS,
+    N_INIT,
+    TOL,
+    set_params_with_hints,
+    setting_hint,
+)
 
 KMEANS_PARAMETERS = (
     N_CLUSTERS, METHOD, MANIFOLD, PRESET_PARAMETER, N_INIT, MAX_ITER, TOL, DTW_WINDOW,
@@ -95,6 +103,22 @@ class RTWKMeans(ClusterMixin, TransformerMixin, BaseEstimator):
     >>> labels[:3] == [labels[0]] * 3 and labels[3:] == [labels[3]] * 3 != labels[:3]
     True
     """
+
+    def set_params(self, **params):
+        """Set parameters, scikit-learn's way; ``method__<setting>`` also works when
+        ``method`` is a name (it becomes the method's object), and a setting that is no
+        parameter says where it belongs.
+
+        Parameters
+        ----------
+        **params : dict
+
+        Returns
+        -------
+        self
+        """
+        set_params_with_hints(self, params, super().set_params)
+        return self
 
     def fit(self, X: Any, y: Any = None):
         """Cluster the series.

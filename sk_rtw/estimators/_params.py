@@ -89,3 +89,26 @@ def setting_hint(name: str) -> str:
     if name == "averager_params":
         return "the averaging settings are the method object's: method=RTW(...)"
     return "see help() for the parameters"
+
+
+def set_params_with_hints(estimator, params: dict, set_params) -> None:
+    """``BaseEstimator.set_params`` (``set_params``) with two additions.
+
+    A method given by name reaches its settings (``method__n_epochs`` on
+    ``method="rtw"``): the name becomes its object, every setting ``"auto"``, which is
+    what the name stands for; a keyword that is no parameter says where it belongs.
+    """
+    from ..methods import get_method
+
+    nested = any(key.startswith("method__") for key in params)
+    if nested and "method" not in params and isinstance(getattr(estimator, "method", None), str):
+        estimator.method = get_method(estimator.method)
+    own = estimator.get_params(deep=False)
+    for key in params:
+        name = key.split("__", 1)[0]
+        if name not in own:
+            raise ValueError(
+                f"Invalid parameter {name!r} for estimator {type(estimator).__name__}: "
+                f"{setting_hint(name)}. Valid parameters are: {sorted(own)}."
+            )
+    set_params(**params)
