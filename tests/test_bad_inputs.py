@@ -721,3 +721,23 @@ def test_an_early_stop_is_announced_with_the_epoch_kept(capsys):
     assert result.n_iter < 200
     assert f"stopped early after {result.n_iter} of 200 epochs: 3 epochs without" in err
     assert f"keeping the warps of epoch {result.best_epoch} (best_epoch" in err
+
+
+def test_every_field_of_a_refined_result_describes_the_refined_mean():
+    from sk_rtw.align._loss import window_weights
+
+    X = np.random.default_rng(0).standard_normal((4, 30)).cumsum(1)
+    plain = align(X, n_epochs=5, random_state=0)
+    refined = align(X, n_epochs=5, refine_steps=2, random_state=0)
+    assert not np.allclose(refined.mean, plain.mean)
+    n, z = refined.warps.shape
+    weights = window_weights(z, refined.config.loss_window, refined.config.loss_step).numpy()
+    distances = Euclidean(1).dist(refined.aligned, refined.mean[None])
+    assert refined.cost == pytest.approx(float((distances @ weights).sum()) / (n * z))
+    assert refined.cost < plain.cost  # the loss at the refined mean, not the stale one
+    assert np.all(np.diff(refined.warps, axis=1) >= 0)
+    np.testing.assert_allclose(refined.warps[:, [0, -1]], [[0.0, 1.0]] * n)
+    # the aligned series sit around the refined mean (before: those of the unrefined one)
+    spread = np.abs((refined.aligned - refined.mean).mean(0)).mean()
+    stale = np.abs((plain.aligned - refined.mean).mean(0)).mean()
+    assert spread < stale / 2

@@ -22,6 +22,7 @@ import torch
 from .._random import check_generator
 from .._resources import available_memory, format_bytes
 from .._threads import limited_threads, threads_for
+from ..dtw import path_indices
 from ..manifolds import Manifold
 from ..manifolds._mean import frechet_mean
 from ..utils import SeriesCollection, check_series_collection
@@ -41,7 +42,7 @@ from ._layout import GroupLayout
 from ._loss import window_weights
 from ._refine import refine_mean
 from ._sinc import TABLE_BYTES, SincInterpolator
-from ._start import dtw_start
+from ._start import dtw_start, path_warp
 from ._training import Trainer, early_stop_note, progress_printer
 from ._warps import NeuralWarps, SineWarps, WarpModel, compose_warps, unit_time
 
@@ -435,17 +436,11 @@ def align_collection(
             _, group_loss, warps, aligned, mean = problem.forward(model)
             mean = _finite(problem.converged_mean(warps, start=mean), original, "the mean")
             costs = group_loss.cpu().numpy()
+            if config.refine_steps > 0:  # the means as free points, towards a lower DTW cost
+                mean, warps, aligned, costs = _refined(problem, collection, layout, mean)
     factor = 1.0 if scale is None else scale
     manifold = collection.manifold
     mean_np, aligned_np, warps_np = mean.cpu().numpy(), aligned.cpu().numpy(), warps.cpu().numpy()
-    if config.refine_steps > 0:  # the means as free points, towards a lower DTW cost
-        mean_np = np.stack([
-            refine_mean(
-                [collection.series(i) for i in layout.members(g)], mean_np[g], manifold,
-                steps=config.refine_steps, window=config.dtw_window,
-            ).mean
-            for g in range(layout.n_groups)
-        ])  # fmt: skip
     fit_time = time.perf_counter() - start_time
     results = []
     for g in range(layout.n_groups):
@@ -465,6 +460,32 @@ def align_collection(
             )
         )
     return results
+
+
+def _refined(problem: _Problem, collection: SeriesCollection, layout: GroupLayout, mean):
+    """Every group's mean refined (:mod:`sk_rtw.align._refine`), and what describes it:
+    each series warped onto its refined mean along their DTW path (as the DTW start
+    warps series onto its reference), those aligned series, and the loss at the refined
+    mean. Returns ``(mean, warps, aligned, costs)`` as the forward pass does."""
+    config, manifold = problem.config, collection.manifold
+    band = -1.0 if config.dtw_window is None else float(config.dtw_window)
+    means = mean.cpu().numpy().copy()
+    warps = np.empty((layout.n_series, config.output_length))
+    for g in range(layout.n_groups):
+        members = layout.members(g)
+        series = [collection.series(i) for i in members]
+        means[g] = refine_mean(series, means[g], manifold, steps=config.refine_steps,
+                               window=config.dtw_window).mean  # fmt: skip
+        for i, s in zip(members, series, strict=True):
+            path, _ = path_indices(means[g], s, manifold, band)
+            warps[i] = path_warp(path, len(means[g]), len(s), smoothing=0.0)  # exact path
+    device = problem.data.device
+    refined = torch.as_tensor(means, dtype=torch.float64, device=device)
+    warps_t = torch.as_tensor(warps, dtype=torch.float64, device=device)
+    aligned = problem.interpolate(warps_t)
+    distances = manifold._dist(aligned, problem.layout.expand(refined))
+    costs = problem.layout.sum((distances @ problem.loss_weights) * problem.series_weight)
+    return refined, warps_t, aligned, costs.cpu().numpy()
 
 
 def _finite(values: torch.Tensor, collection: SeriesCollection, what: str) -> torch.Tensor:

@@ -13,8 +13,10 @@ be pulled by the near-ties that DBA's hard path ignores. ``gamma`` runs down a s
 (:data:`GAMMAS`), in units of the mean squared cost per sample of the DTW paths to the
 start (so it is scale-free), and the iterate with the lowest hard-DTW cost (the
 objective DBA minimises) is kept, never worse than the start. The engine runs it after
-the alignment when ``refine_steps > 0``; ``Alignment.mean`` is then the refined mean
-(the aligned series and warps stay the alignment's).
+the alignment when ``refine_steps > 0``; ``Alignment.mean`` is then the refined mean, and
+every other field describes it: ``warps`` and ``aligned`` are each series warped onto it
+along their DTW path (the warps read off the path, as the DTW start reads them), ``cost``
+the engine's loss at it.
 """
 
 from __future__ import annotations
