@@ -1,7 +1,7 @@
 """Numba kernels: the DTW recursion over a cost matrix, band, backtracking, cost matrices.
 
 The recursion ``D[i, j] = C[i, j] + min(D[i-1, j], D[i, j-1], D[i-1, j-1])`` is written
-once (:func:`_accumulate_row`) and used by every public function. ``fastmath`` is never
+once (:func:`_band_row`) and used by every public function. ``fastmath`` is never
 enabled: the band uses ``inf`` for forbidden cells.
 
 Point distances that numba computes itself are described by "segments" ``(start, stop,
@@ -98,15 +98,7 @@ def _accumulate_row(cost_row, prev, cur, i, lo, hi, ny):
     cur[0] = _INF
     for j in range(1, lo + 1):
         cur[j] = _INF
-    left = _INF
-    for j in range(lo, hi):
-        best = prev[j]
-        if prev[j + 1] < best:
-            best = prev[j + 1]
-        if left < best:
-            best = left
-        left = cost_row[j] + best
-        cur[j + 1] = left
+    _band_row(cost_row, prev, cur, lo, hi)
     for j in range(hi + 1, ny + 1):
         cur[j] = _INF
 
