@@ -741,3 +741,21 @@ def test_every_field_of_a_refined_result_describes_the_refined_mean():
     spread = np.abs((refined.aligned - refined.mean).mean(0)).mean()
     stale = np.abs((plain.aligned - refined.mean).mean(0)).mean()
     assert spread < stale / 2
+
+
+def test_help_of_align_states_the_default_output_length():
+    from sk_rtw.align._presets import PRESETS
+
+    text = " ".join(align.__doc__.split())
+    for name in ("alignment", "paper"):
+        assert PRESETS[name].output_length.formula in text
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf])
+def test_missing_or_infinite_labels_are_refused_without_a_library_warning(bad):
+    y = LABELS.astype(float)
+    y[2] = bad
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ValueError, match=r"y\[2\] is (nan|inf)"):
+            RTWNearestCentroid(method="dba").fit(UNI, y)
