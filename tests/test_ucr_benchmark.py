@@ -11,6 +11,7 @@ import pytest
 from benchmarks.ucr._data import load_split
 from benchmarks.ucr._protocol import paired_test
 from benchmarks.ucr.run import main
+from sk_rtw import RTWNearestCentroid
 
 from .conftest import UCR_DIR
 
@@ -308,3 +309,28 @@ def test_default_rows_make_the_same_choice_and_the_halves_report_adds_up(tmp_pat
         f"RTWNearestCentroid() (band and centroids per class chosen from the training "
         f"data): mean accuracy {default:.4f}" in printed
     )
+
+
+def test_the_candidates_benchmark_scores_every_candidate_and_the_prior_rule(tmp_path, capsys):
+    """Every candidate is a fixed classifier on the test split; the prior rule picks what
+    the estimator's choice picks on the same training series."""
+    from benchmarks.ucr import candidates
+
+    out = tmp_path / "candidates"
+    candidates.main(["--data-dir", str(tmp_path), "--datasets", "GunPoint", "ItalyPowerDemand",
+                     "--methods", "dba", "--out", str(out)])  # fmt: skip
+    printed = capsys.readouterr().out
+    assert "| prior 0.05, k=8, z=1.0 |" in printed and "| best leave-one-out score |" in printed
+    record = json.loads((out / "GunPoint.json").read_text())
+    grid = len(candidates.BANDS) * len(candidates.CENTROIDS)
+    assert len(record["test"]["dba"]) == len(record["loo"]) == grid
+    train = load_split("GunPoint", "train", None)
+    clf = RTWNearestCentroid(method="dba").fit(train.X, train.y)
+    inner = [candidates.key(w, k) for w in candidates.BANDS if w is not None
+             for k in candidates.CENTROIDS if k <= 8]  # fmt: skip
+    assert candidates.prior_rule(record["loo"], "0.05|8", 1.0, inner) == candidates.key(
+        clf.dtw_window_, clf.n_centroids_
+    )
+    test = load_split("GunPoint", "test", None)
+    fixed = record["test"]["dba"][candidates.key(clf.dtw_window_, clf.n_centroids_)]
+    assert fixed == pytest.approx(clf.score(test.X, test.y))
