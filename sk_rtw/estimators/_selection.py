@@ -23,8 +23,8 @@ The matrix of the chosen band then gives each class's partition into ``k`` parts
 (:func:`partition`), and the averaging method fits every part once.
 
 Why these values (UCR development archive, 30 datasets in two fixed halves, docs: UCR
-benchmark): the grid and the rule were chosen on half A from the test accuracy of every
-candidate's centroids, and confirmed on half B. Cross-validated accuracy on training sets
+benchmark; ``benchmarks/ucr/candidates.py``): the grid and the rule were chosen on half A
+from the test accuracy of every candidate's centroids, and confirmed on half B. Cross-validated accuracy on training sets
 of 16-60 series is too noisy to pick the best of 20 candidates (the previous rule, the
 best 3-fold accuracy of DBA centroids, kept the same choice on all of 3 seeds for 8 of 30
 datasets and trailed 1-NN DTW on half A); a good prior that the data must clearly beat
