@@ -24,12 +24,13 @@ The matrix of the chosen band then gives each class's partition into ``k`` parts
 
 Why these values (UCR development archive, 30 datasets in two fixed halves, docs: UCR
 benchmark; ``benchmarks/ucr/candidates.py``): the grid and the rule were chosen on half A
-from the test accuracy of every candidate's centroids, and confirmed on half B. Cross-validated accuracy on training sets
-of 16-60 series is too noisy to pick the best of 20 candidates (the previous rule, the
-best 3-fold accuracy of DBA centroids, kept the same choice on all of 3 seeds for 8 of 30
-datasets and trailed 1-NN DTW on half A); a good prior that the data must clearly beat
-does better on both halves. The full band was never chosen over the narrower ones by any
-rule measured and costs more than the four others together, so it is not a candidate.
+from the test accuracy of every candidate's centroids, and confirmed on half B.
+Cross-validated accuracy on training sets of 16-60 series is too noisy to pick the best of
+16-20 candidates (the previous rule, the best 3-fold accuracy of DBA centroids, kept the
+same choice on all of 3 seeds for 8 of 30 datasets and trailed 1-NN DTW on half A); a good
+prior that the data must clearly beat does better on both halves. The full band was never
+chosen over the narrower ones by any rule measured and costs more than the four others
+together, so it is not a candidate.
 """
 
 from __future__ import annotations
