@@ -146,11 +146,11 @@ class RTWNearestCentroid(ClassifierMixin, RTWAverager):
         if not isinstance(self.temperature, str):  # "auto" was checked with the others
             self.temperature_ = float(self.temperature)
             return self
-        if held_out is not None and np.isfinite(held_out[0]).all(1).sum() >= 2:
+        finite = None if held_out is None else np.isfinite(held_out[0]).all(1)
+        if finite is not None and finite.sum() >= 2:
             # the choice's leave-one-out distances: a centroid that is a training series
             # is at distance 0 from it, which would make the fitted temperature collapse
             distances, codes = held_out
-            finite = np.isfinite(distances).all(1)
             self.temperature_ = fit_temperature(distances[finite], codes[finite])
         else:
             distances = self.transform(X)

@@ -249,8 +249,9 @@ def check_on_data(manifold: Manifold, series: list[np.ndarray], name: str = "X")
     """A quick check of a space the package does not ship, on a few of the user's samples.
 
     The first time a manifold of your own meets data, ``exp`` and ``log`` are checked at
-    up to 12 pairs of neighbouring samples of the first series: shapes (the point shape),
-    finite values, ``log(p, p) = 0`` and the round trip ``exp(p, log(p, x)) = x``. A
+    up to 4 pairs of neighbouring samples in each of the first three series: shapes (the
+    point shape), finite values, ``log(p, p) = 0`` and the round trip
+    ``exp(p, log(p, x)) = x``. A
     space that fails is refused before any work with a ``ValueError`` naming the property;
     :func:`check_manifold` checks the whole contract.
     """
