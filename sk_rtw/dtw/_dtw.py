@@ -82,25 +82,26 @@ def point_cost_matrix(
         )
         return out
     cost = np.asarray(manifold.pairwise_dist(x, y))
-    check_costs(cost, manifold, points=np.concatenate([x, y]))
+    check_costs(cost, manifold, points=(x, y))
     return cost * cost if squared else cost
 
 
 def check_costs(
-    cost: np.ndarray, manifold: Manifold, x: str = "x", y: str = "y", points: Any = None
+    cost: np.ndarray, manifold: Manifold, x: str = "x", y: str = "y", points: tuple = ()
 ) -> None:
     """Refuse non-finite point costs (a manifold's ``dist`` that fails far from a point,
     or geodesics that float64 cannot follow): DTW would return NaN, or a path that is not
     optimal, without saying so.
 
     ``cost`` is ``(T_x, T_y)``; ``x`` and ``y`` name the two series in the message, whose
-    samples ``points`` (optional) let the manifold say what their range is.
+    samples ``points`` (the two series, optional; read only on failure) let the manifold
+    say what their range is.
     """
     bad = ~np.isfinite(cost)
     if not bad.any():
         return
     i, j = (int(k) for k in np.argwhere(bad)[0])
-    note = "" if points is None else manifold.spread_note(points)
+    note = manifold.spread_note(np.concatenate(points)) if points else ""
     raise ValueError(
         f"{manifold!r} gives the distance {cost[i, j]} between {x} at time {i} and {y} at "
         f"time {j}, and {int(bad.sum())} non-finite point costs in all"
@@ -305,10 +306,11 @@ def _pairwise(
                 )
             else:
                 cost = np.asarray(manifold.pairwise_dist(cx.data[i][None], cy.data[chunk]))
-                for k, j in enumerate(chunk):  # the padding beyond a series' end is no cost
+                finite = bool(np.isfinite(cost).all())  # then no pair needs a look
+                for k, j in enumerate([] if finite else chunk):  # padding is no cost
                     check_costs(
                         cost[k, : cx.lengths[i], : cy.lengths[j]], manifold, f"X[{i}]",
-                        f"Y[{j}]", np.concatenate([cx.series(i), cy.series(int(j))]),
+                        f"Y[{j}]", (cx.series(i), cy.series(int(j))),
                     )  # fmt: skip
                 if squared:
                     cost = cost * cost
