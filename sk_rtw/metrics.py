@@ -61,6 +61,29 @@ def restoration_accuracy(
     return _sum_dtw_to(aligned, original, manifold, normalize, window, n_jobs)
 
 
+#: The parameters and result shared by the two sums of DTW distances to a mean.
+_TO_THE_MEAN = """mean : array-like, shape (Z, *point_shape)
+manifold : str or Manifold, default="euclidean"
+normalize : {"path", None}, default="path"
+    DTW normalisation (see the module docstring).
+window : float in [0, 1], optional
+    Sakoe–Chiba band of the DTW (default: none, as in the paper).
+n_jobs : int, optional
+    Threads for the DTW computations.
+
+Returns
+-------
+value : float
+    Sum over the N series; lower is better."""
+
+
+def _to_the_mean_docs(function):
+    body = _TO_THE_MEAN.replace("\n", "\n    ").replace("\n    \n", "\n\n")
+    function.__doc__ = function.__doc__.replace("%(to_the_mean)s", body)
+    return function
+
+
+@_to_the_mean_docs
 def barycenter_loss(
     signals: Any,
     mean: Any,
@@ -75,23 +98,12 @@ def barycenter_loss(
     ----------
     signals : array-like, shape (N, T, *point_shape) or list of series
         The input series (before alignment).
-    mean : array-like, shape (Z, *point_shape)
-    manifold : str or Manifold, default="euclidean"
-    normalize : {"path", None}, default="path"
-        DTW normalisation (see the module docstring).
-    window : float in [0, 1], optional
-        Sakoe–Chiba band of the DTW (default: none, as in the paper).
-    n_jobs : int, optional
-        Threads for the DTW computations.
-
-    Returns
-    -------
-    value : float
-        Sum over the N series; lower is better.
+    %(to_the_mean)s
     """
     return _sum_dtw_to(signals, mean, manifold, normalize, window, n_jobs)
 
 
+@_to_the_mean_docs
 def alignment_quality(
     aligned: Any,
     mean: Any,
@@ -107,18 +119,6 @@ def alignment_quality(
     ----------
     aligned : array-like, shape (N, Z, *point_shape) or list of series
         The aligned series.
-    mean : array-like, shape (Z, *point_shape)
-    manifold : str or Manifold, default="euclidean"
-    normalize : {"path", None}, default="path"
-        DTW normalisation (see the module docstring).
-    window : float in [0, 1], optional
-        Sakoe–Chiba band of the DTW (default: none, as in the paper).
-    n_jobs : int, optional
-        Threads for the DTW computations.
-
-    Returns
-    -------
-    value : float
-        Sum over the N series; lower is better.
+    %(to_the_mean)s
     """
     return _sum_dtw_to(aligned, mean, manifold, normalize, window, n_jobs)
