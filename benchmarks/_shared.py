@@ -1,9 +1,9 @@
 """What every benchmark script starts with: argument types, output checks, method objects.
 
-Each script runs on its own (``python benchmarks/ucr/run.py``); its first lines put the
-repository on ``sys.path`` so that ``benchmarks`` imports, then everything they share
-comes from here. Command-line values are checked by argparse before any work, output
-paths before the first result is computed.
+Each script runs on its own (``python benchmarks/ucr/run.py``); its one start line puts
+the repository on ``sys.path`` (Python looks only in the script's folder), then
+everything the scripts share comes from here. Command-line values are checked by
+argparse before any work, output paths before the first result is computed.
 """
 
 from __future__ import annotations

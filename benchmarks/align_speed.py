@@ -81,7 +81,9 @@ def fit(X, space, method="rtw", threads=1, device="cpu", **options):
         options["n_jobs"] = threads
     else:  # older versions: torch's own thread count
         torch.set_num_threads(threads)
-    options = {k: v for k, v in options.items() if k in accepted or k not in ("n_iter_no_change",)}
+    every = any(p.kind is p.VAR_KEYWORD for p in accepted.values())  # align(X, **settings)
+    options = {k: v for k, v in options.items()
+               if every or k in accepted or k not in ("n_iter_no_change",)}
     return align(X, manifold=space, method=method, random_state=0, device=device, **options)
 """
 

@@ -22,11 +22,9 @@ from pathlib import Path
 import numpy as np
 import torch
 
-ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the repository; then _shared
 
-from sk_rtw import (  # noqa: E402
+from sk_rtw import (
     NTW,
     RTW,
     TTW,
@@ -35,8 +33,8 @@ from sk_rtw import (  # noqa: E402
     TTWAverager,
     align,
 )
-from sk_rtw.datasets import make_warped_signals  # noqa: E402
-from sk_rtw.manifolds import SPD, Euclidean, Product, Quaternion, Sphere  # noqa: E402
+from sk_rtw.datasets import make_warped_signals
+from sk_rtw.manifolds import SPD, Euclidean, Product, Quaternion, Sphere
 
 SPACES = [
     Euclidean(2),

@@ -28,12 +28,10 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the repository; then _shared
 
-from benchmarks._shared import machine, positive_int  # noqa: E402
-from sk_rtw import RTWNearestCentroid, dtw_pairwise_distance  # noqa: E402
+from benchmarks._shared import machine, positive_int
+from sk_rtw import RTWNearestCentroid, dtw_pairwise_distance
 
 #: (training series, test series, samples, classes) of each synthetic set.
 SETS = {

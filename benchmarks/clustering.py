@@ -40,14 +40,12 @@ from pathlib import Path
 import numpy as np
 from sklearn.metrics import adjusted_rand_score
 
-ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the repository; then _shared
 
-from benchmarks._shared import method_object  # noqa: E402
-from benchmarks.ucr._data import AEON_BUNDLED, available_datasets, load_split  # noqa: E402
-from sk_rtw import RTWKMeans, RTWNearestCentroid, dtw_pairwise_distance  # noqa: E402
-from sk_rtw.manifolds import Sphere  # noqa: E402
+from benchmarks._shared import method_object
+from benchmarks.ucr._data import AEON_BUNDLED, available_datasets, load_split
+from sk_rtw import RTWKMeans, RTWNearestCentroid, dtw_pairwise_distance
+from sk_rtw.manifolds import Sphere
 
 CENTROIDS = (1, 2, 4, 8)
 SECTIONS = ("tslearn", "manifolds", "centroids", "classify")

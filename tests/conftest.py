@@ -9,8 +9,12 @@ import pytest
 import torch
 
 from sk_rtw.manifolds import SPD, Euclidean, Product, Quaternion, Sphere
+from sk_rtw.methods import get_method
 
 torch.set_default_dtype(torch.float64)
+
+#: Checked by mypy, not run (``--doctest-modules`` would import it).
+collect_ignore = ["typing"]
 
 #: One instance of every kind of space, used by the contract tests.
 MANIFOLDS = [
@@ -41,8 +45,13 @@ def manifold_id(m) -> str:
     return repr(m)
 
 
-def quick(name: str = "rtw", **settings):
-    """A method object for fast tests: 2 epochs, a width-8 network where there is one."""
-    from benchmarks._shared import method_object
+#: The settings of :func:`quick`, for the methods that have them.
+QUICK = {"n_epochs": 2, "hidden_size": 8}
 
-    return method_object(name, **{"n_epochs": 2, "hidden_size": 8, **settings})
+
+def quick(name: str = "rtw", **settings):
+    """A method object for fast tests: 2 epochs and a width-8 network where the method has
+    them; ``settings`` must be the method's own (``set_params`` refuses any other)."""
+    method = get_method(name)
+    own = method.get_params(deep=False)
+    return method.set_params(**{**{k: v for k, v in QUICK.items() if k in own}, **settings})

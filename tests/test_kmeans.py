@@ -53,11 +53,10 @@ def test_sklearn_compatible(estimator, check):
     check(estimator)
 
 
-@pytest.mark.parametrize("method", ["dba", "rtw"])
+@pytest.mark.parametrize("method", [DBA(), RTW(n_epochs=32, hidden_size=64)], ids=repr)
 def test_recovers_warped_copies_of_three_shapes(method):
     X, y = three_shapes()
-    km = RTWKMeans(3, method=quick(method, n_epochs=32, hidden_size=64), n_init=2,
-                   random_state=0).fit(X)  # fmt: skip
+    km = RTWKMeans(3, method=method, n_init=2, random_state=0).fit(X)
     assert adjusted_rand_score(y, km.labels_) == 1.0
     assert km.cluster_centers_.shape == (3, 40, 1)
     np.testing.assert_array_equal(km.predict(X), km.labels_)
@@ -154,9 +153,10 @@ def test_several_centroids_capture_a_class_made_of_two_shapes():
     one = RTWNearestCentroid(method="dba", n_centroids=1, dtw_window=None).fit(X, y)
     two = RTWNearestCentroid(method="dba", n_centroids=2, dtw_window=None).fit(X, y)
     assert len(two.means_) == 4 and two.centroid_classes_.tolist() == [0, 0, 1, 1]
-    distances = two.transform(X)
+    distances = two.class_distances(X)  # to every class: its nearest centroid
     assert distances.shape == (18, 2)
-    all_centroids = RTWAverager.transform(two, X)  # to every centroid
+    all_centroids = two.transform(X)  # to every centroid, as RTWAverager.transform
+    assert all_centroids.shape == (18, 4)
     np.testing.assert_allclose(distances[:, 0], all_centroids[:, :2].min(1))
     assert two.score(X, y) == 1.0
     assert two.score(X, y) >= one.score(X, y)

@@ -61,12 +61,10 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[2]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the repository; then _shared
 
-from benchmarks._shared import positive_int  # noqa: E402
-from benchmarks.paper._common import (  # noqa: E402
+from benchmarks._shared import positive_int
+from benchmarks.paper._common import (
     LABELS,
     paper_parser,
     parse_paper_args,
@@ -74,15 +72,15 @@ from benchmarks.paper._common import (  # noqa: E402
     unaligned,
     write_markdown,
 )
-from benchmarks.paper._data import (  # noqa: E402
+from benchmarks.paper._data import (
     data_dir,
     icsc_carrot_grating,
     icsc_wiping,
     rcfs_letter,
     rlasa_quaternions,
 )
-from sk_rtw import aligned_statistics, dtw_distance  # noqa: E402
-from sk_rtw.manifolds import Euclidean, Manifold, Product, Quaternion  # noqa: E402
+from sk_rtw import aligned_statistics, dtw_distance
+from sk_rtw.manifolds import Euclidean, Manifold, Product, Quaternion
 
 PREPARATIONS = ("raw", "ttw", "ntw", "dba", "rtw", "rtw-paper")
 MODELS = ("DMP", "GMR", "GP")

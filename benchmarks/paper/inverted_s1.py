@@ -25,23 +25,13 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[2]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the repository; then _shared
 
-from benchmarks._shared import positive_int  # noqa: E402
-from benchmarks.paper._common import (  # noqa: E402
-    markdown_table,
-    paper_parser,
-    parse_paper_args,
-    run_method,
-    score,
-    unaligned,
-    write_markdown,
-)
-from sk_rtw import metrics  # noqa: E402
-from sk_rtw.datasets import make_warped_signals  # noqa: E402
-from sk_rtw.manifolds import Sphere  # noqa: E402
+from benchmarks._shared import positive_int
+from benchmarks.paper import _common as paper
+from sk_rtw import metrics
+from sk_rtw.datasets import make_warped_signals
+from sk_rtw.manifolds import Sphere
 
 T = 100
 PAPER = {  # Tables III (N = 4) and IV (N = 30): RA, BL, AQ, CPU seconds
@@ -77,9 +67,9 @@ def run(n_signals, methods, trials, epochs, output_length, device, seed):
     results = {m: [] for m in ("unaligned", *methods)}
     for trial in range(trials):
         data = make_warped_signals(M, n_signals, T, seed + trial)
-        outcomes = {"unaligned": unaligned(data.signals, M)}
+        outcomes = {"unaligned": paper.unaligned(data.signals, M)}
         for method in methods:
-            outcomes[method] = run_method(
+            outcomes[method] = paper.run_method(
                 method,
                 data.signals,
                 M,
@@ -89,7 +79,7 @@ def run(n_signals, methods, trials, epochs, output_length, device, seed):
                 device=device,
             )
         for method, outcome in outcomes.items():
-            values = score(outcome, data.signals, M, data.original)
+            values = paper.score(outcome, data.signals, M, data.original)
             values["RA band"] = metrics.restoration_accuracy(
                 outcome.aligned, data.original, M, window=0.1
             )
@@ -100,7 +90,7 @@ def run(n_signals, methods, trials, epochs, output_length, device, seed):
 
 
 def main(argv=None) -> None:
-    parser = paper_parser(__doc__, data=False)
+    parser = paper.paper_parser(__doc__, data=False)
     parser.add_argument("--n-signals", type=positive_int, nargs="+", default=[4, 30])
     parser.add_argument("--methods", nargs="+", help="default: the paper's table plus DBA")
     parser.add_argument("--trials", type=positive_int, default=100, help="paper: 100")
@@ -109,7 +99,7 @@ def main(argv=None) -> None:
         help="Z (default: the preset's, min(N, 4) T for RTW/TTW/NTW)",
     )  # fmt: skip
     parser.add_argument("--quick", action="store_true", help="1 trial, 64 epochs")
-    args = parse_paper_args(parser, argv)
+    args = paper.parse_paper_args(parser, argv)
     if args.quick:
         args.trials, args.epochs = 1, 64
     sections = {}
@@ -121,8 +111,8 @@ def main(argv=None) -> None:
             )
             z = output_length or f"{min(n_signals, 4) * T} (paper presets: {n_signals * T})"
             title = f"N = {n_signals}, T = {T}, Z = {z}, {args.trials} trial(s)"
-            sections[title] = markdown_table(results, COLUMNS, PAPER.get(n_signals))
-    write_markdown(
+            sections[title] = paper.markdown_table(results, COLUMNS, PAPER.get(n_signals))
+    paper.write_markdown(
         args.markdown,
         "Inverted time warping on S^1 (paper, section V-B, Tables III and IV)",
         f"""

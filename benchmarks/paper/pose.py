@@ -27,24 +27,13 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[2]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the repository; then _shared
 
-from benchmarks._shared import check_writable  # noqa: E402
-from benchmarks.paper._common import (  # noqa: E402
-    LABELS,
-    markdown_table,
-    paper_parser,
-    parse_paper_args,
-    run_method,
-    score,
-    unaligned,
-    write_markdown,
-)
-from benchmarks.paper._data import data_dir, icsc_carrot_grating, icsc_wiping  # noqa: E402
-from sk_rtw import metrics  # noqa: E402
-from sk_rtw.manifolds import Euclidean, Product, Quaternion  # noqa: E402
+from benchmarks._shared import check_writable
+from benchmarks.paper import _common as paper
+from benchmarks.paper._data import data_dir, icsc_carrot_grating, icsc_wiping
+from sk_rtw import metrics
+from sk_rtw.manifolds import Euclidean, Product, Quaternion
 
 COLUMNS = ("BL", "AQ", "AQ position", "AQ orientation", "speed peak", "seconds")
 TASKS = {"grating": (icsc_carrot_grating, 10), "wiping": (icsc_wiping, 5)}
@@ -71,12 +60,14 @@ def rotation_matrices(q: np.ndarray) -> np.ndarray:
 
 def evaluate(series, methods, epochs, seed, device):
     M = Product((Euclidean(3), Quaternion()))
-    outcomes = {"interpolation": unaligned(series, M)}
+    outcomes = {"interpolation": paper.unaligned(series, M)}
     for method in methods:
-        outcomes[method] = run_method(method, series, M, epochs=epochs, seed=seed, device=device)
+        outcomes[method] = paper.run_method(
+            method, series, M, epochs=epochs, seed=seed, device=device
+        )
     results = {}
     for method, outcome in outcomes.items():
-        values = score(outcome, series, M)
+        values = paper.score(outcome, series, M)
         for part, space, cols in (
             ("position", Euclidean(3), slice(0, 3)),
             ("orientation", Quaternion(), slice(3, 7)),
@@ -108,7 +99,7 @@ def draw(task: str, series, outcomes: dict, path: Path) -> None:
         R = rotation_matrices(mean[frames, 3:])
         for axis, color in zip(range(3), ("tab:red", "tab:green", "tab:blue"), strict=True):
             ax.quiver(*mean[frames, :3].T, *R[:, :, axis].T, length=0.08 * span, color=color)
-        ax.set_title(LABELS.get(method, method))
+        ax.set_title(paper.LABELS.get(method, method))
         ax.set_xlabel("x [m]")
         ax.set_ylabel("y [m]")
         ax.set_zlabel("z [m]")
@@ -120,7 +111,7 @@ def draw(task: str, series, outcomes: dict, path: Path) -> None:
 
 
 def main(argv=None) -> None:
-    parser = paper_parser(__doc__)
+    parser = paper.paper_parser(__doc__)
     parser.add_argument("--tasks", nargs="+", default=list(TASKS), choices=list(TASKS))
     parser.add_argument("--methods", nargs="+", default=["ttw", "ntw", "rtw", "dba"])
     parser.add_argument("--figure-dir", help="write pose_<task>.png figures here")
@@ -129,7 +120,7 @@ def main(argv=None) -> None:
         "--full-resolution", action="store_true",
         help="every sample (grating 2,322-3,371, wiping 1,096-1,457) instead of every 10th / 5th",
     )  # fmt: skip
-    args = parse_paper_args(parser, argv)
+    args = paper.parse_paper_args(parser, argv)
     if args.figure_dir:
         check_writable(args.figure_dir, directory=True)
     root = data_dir(args.data_dir)
@@ -146,12 +137,12 @@ def main(argv=None) -> None:
         lengths = sorted(len(s) for s in series)
         every = "every sample" if step == 1 else f"every {step}th sample"
         title = f"{task}: N = {len(series)}, T = {lengths[0]}-{lengths[-1]} ({every})"
-        sections[title] = markdown_table({m: [v] for m, v in results.items()}, COLUMNS)
+        sections[title] = paper.markdown_table({m: [v] for m, v in results.items()}, COLUMNS)
         if args.figure_dir:
             draw(task, series, outcomes, Path(args.figure_dir) / f"pose_{task}.png")
             sections[title] += f"\n\n![{task}](pose_{task}.png)"
         print(f"{task}: done", file=sys.stderr, flush=True)
-    write_markdown(
+    paper.write_markdown(
         args.markdown,
         "Real pose demonstrations in R^3 x S^3 (paper, section V-D)",
         f"""

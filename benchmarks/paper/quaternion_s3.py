@@ -21,33 +21,25 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[2]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the repository; then _shared
 
-from benchmarks._shared import positive_float, positive_int  # noqa: E402
-from benchmarks.paper._common import (  # noqa: E402
-    evaluate,
-    markdown_table,
-    paper_parser,
-    parse_paper_args,
-    write_markdown,
-)
-from benchmarks.paper._data import (  # noqa: E402
+from benchmarks._shared import positive_float, positive_int
+from benchmarks.paper import _common as paper
+from benchmarks.paper._data import (
     data_dir,
     letters_on_s3,
     rcfs_letter,
     rlasa_quaternions,
     rlasa_shapes,
 )
-from sk_rtw.manifolds import Quaternion  # noqa: E402
+from sk_rtw.manifolds import Quaternion
 
 PAPER = {"qdtw": (0.0359, 0.0338), "rtw": (0.0339, 0.0338)}  # Table V: BL, AQ
 COLUMNS = ("BL", "AQ", "seconds")
 
 
 def main(argv=None) -> None:
-    parser = paper_parser(__doc__)
+    parser = paper.paper_parser(__doc__)
     parser.add_argument("--methods", nargs="+", default=["qdtw", "rtw", "dba"])
     parser.add_argument("--letter", default="G")
     parser.add_argument("--n-signals", type=positive_int, default=4)
@@ -58,7 +50,7 @@ def main(argv=None) -> None:
     parser.add_argument("--lasa-step", type=positive_int, default=10, help="R-LASA subsampling")
     parser.add_argument("--shapes", nargs="*", help="R-LASA shapes (default: all 30)")
     parser.add_argument("--quick", action="store_true", help="T = 100, 64 epochs, 3 shapes")
-    args = parse_paper_args(parser, argv)
+    args = paper.parse_paper_args(parser, argv)
     root = data_dir(args.data_dir)
     shapes = args.shapes or rlasa_shapes(root)
     if args.quick:
@@ -69,7 +61,7 @@ def main(argv=None) -> None:
     X = letters_on_s3(letters, args.scale)
     rcfs = {
         m: [v]
-        for m, v in evaluate(
+        for m, v in paper.evaluate(
             X, Quaternion(), args.methods, epochs=args.epochs, seed=args.seed, device=args.device
         ).items()
     }
@@ -78,7 +70,7 @@ def main(argv=None) -> None:
     lasa = {m: [] for m in ("unaligned", *args.methods)}
     for shape in shapes:
         X = rlasa_quaternions(root, shape)[:, :: args.lasa_step]
-        scores = evaluate(
+        scores = paper.evaluate(
             X, Quaternion(), args.methods, epochs=args.epochs, seed=args.seed, device=args.device
         )
         for method, values in scores.items():
@@ -86,7 +78,7 @@ def main(argv=None) -> None:
         print(f"R-LASA {shape}: done", file=sys.stderr, flush=True)
 
     T = letters.shape[1]
-    write_markdown(
+    paper.write_markdown(
         args.markdown,
         "Unit quaternions S^3 (paper, section V-C, Table V)",
         f"""
@@ -100,10 +92,10 @@ rankings, not values.
 """,
         {
             f"RCFS letter {args.letter}, N = {len(letters)}, T = {T}, c = {args.scale}": (
-                markdown_table(rcfs, COLUMNS, PAPER)
+                paper.markdown_table(rcfs, COLUMNS, PAPER)
             ),
             f"R-LASA quaternions, {len(shapes)} shapes, N = 4, T = {1000 // args.lasa_step}": (
-                "Mean ± std over shapes.\n\n" + markdown_table(lasa, COLUMNS)
+                "Mean ± std over shapes.\n\n" + paper.markdown_table(lasa, COLUMNS)
             ),
         },
     )

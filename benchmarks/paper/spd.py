@@ -29,19 +29,11 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[2]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the repository; then _shared
 
-from benchmarks._shared import positive_int  # noqa: E402
-from benchmarks.paper._common import (  # noqa: E402
-    evaluate,
-    markdown_table,
-    paper_parser,
-    parse_paper_args,
-    write_markdown,
-)
-from benchmarks.paper._data import (  # noqa: E402
+from benchmarks._shared import positive_int
+from benchmarks.paper import _common as paper
+from benchmarks.paper._data import (
     data_dir,
     planar_arm_kinematics,
     planar_arm_mass_matrix,
@@ -50,7 +42,7 @@ from benchmarks.paper._data import (  # noqa: E402
     rlasa_spd,
     track_with_planar_arm,
 )
-from sk_rtw.manifolds import SPD  # noqa: E402
+from sk_rtw.manifolds import SPD
 
 PAPER = {  # Table VI: BL, AQ per matrix size
     2: {"mmddtw": (42.1131, 42.3271), "mmddtw_c": (43.8988, 44.6875), "rtw": (33.5702, 23.0621)},
@@ -80,7 +72,7 @@ def spd_of(X) -> SPD:
 
 
 def main(argv=None) -> None:
-    parser = paper_parser(__doc__)
+    parser = paper.paper_parser(__doc__)
     parser.add_argument("--methods", nargs="+", default=["mmddtw", "mmddtw_c", "rtw", "dba"])
     parser.add_argument("--sizes", type=positive_int, nargs="+", default=[2, 8, 32])
     parser.add_argument("--letter", default="G")
@@ -95,7 +87,7 @@ def main(argv=None) -> None:
     parser.add_argument("--large-step", type=positive_int, default=2,
                         help="subsampling, sizes >= 16")  # fmt: skip
     parser.add_argument("--quick", action="store_true", help="T = 100, 64 epochs, 3 shapes")
-    args = parse_paper_args(parser, argv)
+    args = paper.parse_paper_args(parser, argv)
     root = data_dir(args.data_dir)
     shapes = args.shapes or rlasa_shapes(root)
     if args.quick:
@@ -111,19 +103,19 @@ def main(argv=None) -> None:
         X = robot_signals(letters[:, ::step], size)
         results = {
             m: [v]
-            for m, v in evaluate(
+            for m, v in paper.evaluate(
                 X, spd_of(X), args.methods, epochs=epochs, seed=args.seed, device=args.device
             ).items()
         }
         what = "manipulability of a 3-link arm" if size == 2 else f"mass matrix, {size} links"
         title = f"SPD({size}): {what}, N = {len(X)}, T = {X.shape[1]}, {epochs} epochs"
-        sections[title] = markdown_table(results, COLUMNS, PAPER.get(size))
+        sections[title] = paper.markdown_table(results, COLUMNS, PAPER.get(size))
         print(f"SPD({size}): done", file=sys.stderr, flush=True)
 
     lasa = {m: [] for m in ("unaligned", *args.methods)}
     for shape in shapes:
         X = rlasa_spd(root, shape)[: args.lasa_signals, :: args.lasa_step]
-        scores = evaluate(
+        scores = paper.evaluate(
             X, spd_of(X), args.methods, epochs=args.epochs, seed=args.seed, device=args.device
         )
         for method, values in scores.items():
@@ -133,8 +125,8 @@ def main(argv=None) -> None:
         f"R-LASA SPD(2), {len(shapes)} shapes, N = {args.lasa_signals}, "
         f"T = {1000 // args.lasa_step}"
     )
-    sections[title] = "Mean ± std over shapes.\n\n" + markdown_table(lasa, COLUMNS)
-    write_markdown(
+    sections[title] = "Mean ± std over shapes.\n\n" + paper.markdown_table(lasa, COLUMNS)
+    paper.write_markdown(
         args.markdown,
         "SPD matrices (paper, section V-C, Table VI)",
         f"""

@@ -156,7 +156,7 @@ def _fit_estimator(method, train, test, config):
         )
         barycenter[members] = dtw_pairwise_distance(series, mean)[:, 0]
     start = time.perf_counter()
-    distances = estimator.transform(test.X)
+    distances = estimator.class_distances(test.X)
     predictions = estimator.classes_[distances.argmin(1)]
     return {
         "fit_seconds": fit_seconds,

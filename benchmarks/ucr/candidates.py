@@ -27,16 +27,14 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[2]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the repository; then _shared
 
-from benchmarks._shared import check_writable, existing_directory  # noqa: E402
-from benchmarks.ucr._data import available_datasets, load_split  # noqa: E402
-from benchmarks.ucr._summary import split_halves  # noqa: E402
-from sk_rtw import RTWNearestCentroid, dtw_pairwise_distance  # noqa: E402
-from sk_rtw.estimators._medoids import loo_class_distances  # noqa: E402
-from sk_rtw.estimators._selection import mcnemar  # noqa: E402
+from benchmarks._shared import check_writable, existing_directory
+from benchmarks.ucr._data import available_datasets, load_split
+from benchmarks.ucr._summary import split_halves
+from sk_rtw import RTWNearestCentroid, dtw_pairwise_distance
+from sk_rtw.estimators._medoids import loo_class_distances
+from sk_rtw.estimators._selection import mcnemar
 
 BANDS = (0.0, 0.05, 0.1, 0.2, None)
 CENTROIDS = (1, 2, 4, 8, 16)

@@ -50,11 +50,9 @@ import sys
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[2]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the repository; then _shared
 
-from benchmarks._shared import (  # noqa: E402
+from benchmarks._shared import (
     check_writable,
     existing_directory,
     job_count,
@@ -63,8 +61,8 @@ from benchmarks._shared import (  # noqa: E402
     positive_float,
     positive_int,
 )
-from benchmarks.ucr._cluster import connect  # noqa: E402
-from benchmarks.ucr._data import (  # noqa: E402
+from benchmarks.ucr._cluster import connect
+from benchmarks.ucr._data import (
     AEON_BUNDLED,
     ENV_DATA_DIR,
     DatasetUnavailable,
@@ -72,21 +70,21 @@ from benchmarks.ucr._data import (  # noqa: E402
     check_available,
     default_data_dir,
 )
-from benchmarks.ucr._protocol import (  # noqa: E402
+from benchmarks.ucr._protocol import (
     ALL_METHODS,
     DEFAULT_METHODS,
     RunConfig,
     process_dataset,
 )
-from benchmarks.ucr._summary import (  # noqa: E402
+from benchmarks.ucr._summary import (
     critical_difference_plot,
     load_records,
     markdown,
     scatter_plot,
     verdict,
 )
-from sk_rtw.align import PRESETS  # noqa: E402
-from sk_rtw.align._config import check_device  # noqa: E402
+from sk_rtw.align import PRESETS
+from sk_rtw.align._config import check_device
 
 
 def parse_args(argv=None) -> argparse.Namespace:
