@@ -319,7 +319,7 @@ def aligned_statistics(
 
     Parameters
     ----------
-    alignment : Alignment or MultipleAlignment, optional
+    alignment : Alignment or sk_rtw.baselines.MultipleAlignment, optional
         The result of :func:`sk_rtw.align` or of a baseline (``aligned``, ``mean``,
         ``manifold`` are read from it).
     aligned : array-like of shape (N, Z, *point_shape), optional

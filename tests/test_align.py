@@ -169,7 +169,7 @@ def test_householder_basis_is_orthonormal_with_constant_first_vector(n):
 
 def test_neural_warps_match_the_paper_architecture():
     n = 6
-    model = NeuralWarps(n, init="xavier")
+    model = NeuralWarps(n, hidden=512, init="xavier")
     n_params = sum(p.numel() for p in model.parameters())
     assert n_params == 263680 + 1025 * (n - 1) + (n - 1)
     zhat = unit_time(50)
@@ -178,7 +178,7 @@ def test_neural_warps_match_the_paper_architecture():
     np.testing.assert_array_equal(raw[:, -1].numpy(), 1.0)
     np.testing.assert_allclose(raw.mean(0).numpy(), zhat.numpy(), atol=1e-12)  # mean warp
     assert raw.std(0).max() > 1e-3  # Xavier init breaks the symmetry
-    zero = NeuralWarps(n, init="zeros")
+    zero = NeuralWarps(n, hidden=512, init="zeros")
     np.testing.assert_array_equal(zero(zhat).detach().numpy(), zhat.expand(n, -1).numpy())
 
 
@@ -192,8 +192,8 @@ def test_linear_resampling_equals_numpy_interp(rng):
 
 def test_warps_on_knots_interpolate_the_network_between_them():
     torch.manual_seed(0)
-    exact = NeuralWarps(5, hidden=32, knots=None)
-    knotted = NeuralWarps(5, hidden=32, knots=11)
+    exact = NeuralWarps(5, hidden=32, init="xavier", knots=None)
+    knotted = NeuralWarps(5, hidden=32, init="xavier", knots=11)
     knotted.load_state_dict(exact.state_dict())
     zhat = unit_time(101)
     at_knots = unit_time(11)
@@ -208,7 +208,7 @@ def test_warps_on_knots_interpolate_the_network_between_them():
     np.testing.assert_array_equal(raw[:, -1].numpy(), 1.0)
     np.testing.assert_allclose(raw.mean(0).numpy(), zhat.numpy(), atol=1e-12)
     # at least as many knots as output times: the network at every output time
-    full = NeuralWarps(5, hidden=32, knots=200)
+    full = NeuralWarps(5, hidden=32, init="xavier", knots=200)
     full.load_state_dict(exact.state_dict())
     np.testing.assert_array_equal(full(zhat).detach().numpy(), exact(zhat).detach().numpy())
 
@@ -661,8 +661,7 @@ def test_groups_in_one_batch_equal_separate_fits(method):
 
     series, codes = _groups_data()
     collection = check_series_collection(series, "sphere")
-    config = resolve_config(method, "alignment", {"output_length": 50, "n_epochs": 30},
-                            collection.lengths)  # fmt: skip
+    config = resolve_config(method, "alignment", {"output_length": 50, "n_epochs": 30})
     # align(random_state=s) seeds its one group with the first draw of default_rng(s)
     seeds = [int(np.random.default_rng(s).integers(2**31 - 1)) for s in (11, 22)]
     batch = align_collection(collection, codes, seeds, config)

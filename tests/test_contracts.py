@@ -20,10 +20,16 @@ import pytest
 from sklearn.base import clone
 
 from sk_rtw import RTW, RTWAverager, RTWKMeans, RTWNearestCentroid, align
-from sk_rtw.align import ENGINE_METHODS, KNOBS, METHODS, PRESETS
-from sk_rtw.align._config import knobs_markdown, presets_markdown, resolve_config, resolve_knobs
+from sk_rtw.align import ENGINE_METHODS, KNOBS, PRESETS
+from sk_rtw.align._config import (
+    knobs_markdown,
+    presets_markdown,
+    resolve_config,
+    resolve_knobs,
+    size_config,
+)
 from sk_rtw.datasets import make_warped_signals
-from sk_rtw.methods import RESULT_FIELDS, AveragingResult, FitContext, get_method
+from sk_rtw.methods import METHODS, RESULT_FIELDS, AveragingResult, FitContext, get_method
 from sk_rtw.utils import check_series_collection
 
 from .conftest import MANIFOLDS, manifold_id, quick
@@ -77,11 +83,12 @@ def test_a_batch_of_classes_equals_separate_fits(name, M):
     X, y = two_classes(M)
     collection = check_series_collection(X, M)
     method, context, seeds = quick(name), FitContext(preset="class-means"), [11, 22]
-    batch = method.fit_groups(collection, y, seeds, context)
+    config = method.configure(context)
+    batch = method.fit_groups(collection, y, seeds, config, context)
     for g, seed in enumerate(seeds):
         members = np.flatnonzero(y == g)
         (alone,) = method.fit_groups(
-            collection.subset(members), np.zeros(len(members), int), [seed], context
+            collection.subset(members), np.zeros(len(members), int), [seed], config, context
         )
         np.testing.assert_allclose(batch[g].mean, alone.mean, atol=1e-9)
         np.testing.assert_allclose(batch[g].warps, alone.warps, atol=1e-9)
@@ -112,7 +119,7 @@ def resolved_presets() -> dict:
     for preset in PRESETS:
         for method in METHODS:
             if method in ENGINE_METHODS:
-                values = resolve_config(method, preset, {}, lengths).to_dict()
+                values = size_config(resolve_config(method, preset, {}), lengths).to_dict()
             else:
                 values = resolve_knobs(method, preset, {})
             out[f"{preset}/{method}"] = values

@@ -124,7 +124,7 @@ def test_pipeline_gridsearch_clone_pickle_and_cross_validation():
 def test_outputs_and_probabilities():
     X, y = two_shape_classes()
     clf = RTWNearestCentroid(method=RTW(n_epochs=15, hidden_size=16), random_state=0).fit(X, y)
-    distances = clf.transform(X)
+    distances = clf.class_distances(X)
     assert distances.shape == (12, 2) and np.all(distances >= 0)
     proba = clf.predict_proba(X)
     np.testing.assert_allclose(proba.sum(1), 1.0)
@@ -380,7 +380,7 @@ def test_a_given_temperature_is_used_as_is():
     y = [0, 0, 1, 1]
     clf = RTWNearestCentroid(method="dba", temperature=2.5).fit(X, y)
     assert clf.temperature_ == 2.5
-    expected = softmax(-clf.transform(X) / 2.5, axis=1)
+    expected = softmax(-clf.class_distances(X) / 2.5, axis=1)
     np.testing.assert_allclose(clf.predict_proba(X), expected)
     assert "temperature" in TTWNearestCentroid().get_params()
 

@@ -246,10 +246,10 @@ def test_probabilities_are_fitted_on_held_out_distances():
     X_new, y_new = overlapping(100, 1)
     clf = RTWNearestCentroid(method="dba").fit(X, y)
     assert clf.n_centroids_ > 1  # some centroids are single training series
-    naive = fit_temperature(clf.transform(X), y)
+    naive = fit_temperature(clf.class_distances(X), y)
     assert clf.temperature_ > 2 * naive
     proba = clf.predict_proba(X_new)
     np.testing.assert_allclose(proba.sum(1), 1.0)
-    distances = clf.transform(X_new)
+    distances = clf.class_distances(X_new)
     overconfident = softmax(-distances / naive, axis=1)
     assert log_loss(y_new, proba) < log_loss(y_new, overconfident)

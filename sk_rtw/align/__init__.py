@@ -2,14 +2,13 @@
 
 from ._config import AlignmentConfig, knobs_markdown, presets_markdown
 from ._engine import Alignment, align
-from ._knobs import ENGINE_METHODS, KNOBS, METHODS, Knob
+from ._knobs import ENGINE_METHODS, KNOBS, Knob
 from ._presets import PRESETS, OutputLength, Preset
 from ._sinc import tangent_sinc_interpolate
 
 __all__ = [
     "ENGINE_METHODS",
     "KNOBS",
-    "METHODS",
     "PRESETS",
     "Alignment",
     "AlignmentConfig",

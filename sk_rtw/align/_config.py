@@ -13,18 +13,15 @@ everywhere. The tables of the docs are rendered from the same records
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import asdict, dataclass, fields
+from dataclasses import asdict, dataclass, fields, replace
 from typing import Any
 
 import numpy as np
 import torch
 
 from ..utils._params import AUTO, InstanceOf, Options, Parameter
-from ._knobs import ENGINE_METHODS, KNOBS, METHODS, method_knobs, owners
+from ._knobs import ENGINE_METHODS, KNOBS, method_knobs, owners
 from ._presets import PRESETS
-
-#: Display names of the methods.
-METHOD_LABELS = {"rtw": "RTW", "ttw": "TTW", "ntw": "NTW", "dba": "DBA"}
 
 
 @dataclass(frozen=True)
@@ -46,7 +43,7 @@ class AlignmentConfig:
     init: str | None
     warp_start: str
     dtw_rounds: int
-    output_length: int
+    output_length: int | None
     n_epochs: int
     learning_rate: float
     sinc_window: int | None
@@ -151,7 +148,7 @@ def check_knobs(method: str, values: Mapping[str, Any], owner: str = "align()") 
     InvalidParameterError
         For a value the knob does not accept.
     """
-    label = METHOD_LABELS[method]
+    label = method.upper()
     mine = {knob.name for knob in method_knobs(method)}
     checked = {}
     for name, value in values.items():
@@ -163,7 +160,7 @@ def check_knobs(method: str, values: Mapping[str, Any], owner: str = "align()") 
                 )
             raise TypeError(
                 f"{name} is not a setting of {label} (it sets "
-                f"{', '.join(METHOD_LABELS[m] for m in others)}); {label}'s settings are "
+                f"{', '.join(m.upper() for m in others)}); {label}'s settings are "
                 f"{sorted(mine)}"
             )
         canonical = knob_parameter(name).check(value)
@@ -183,23 +180,20 @@ def resolve_config(
     method: str,
     preset: str,
     explicit: Mapping[str, Any],
-    lengths: Any,
     *,
     device: str = "cpu",
     given_start: bool = False,
     dtw_window: float | None = None,
 ) -> AlignmentConfig:
-    """The engine configuration of ``method`` for series of these ``lengths``.
+    """The engine configuration of ``method``: preset, then method, then ``explicit``.
 
     Parameters
     ----------
     method : {"rtw", "ttw", "ntw"}
     preset : str
-        A key of :data:`sk_rtw.align.PRESETS`.
+        A key of :data:`sk_rtw.methods.PRESETS`.
     explicit : mapping
         Checked explicit knob values (:func:`check_knobs`).
-    lengths : array-like of int
-        Lengths of the series averaged together (the output length rule reads them).
     device : str, default="cpu"
         A checked device.
     given_start : bool, default=False
@@ -210,13 +204,10 @@ def resolve_config(
     Returns
     -------
     AlignmentConfig
+        ``output_length`` None unless given: :func:`size_config` applies the preset's
+        rule to the series.
     """
     values = resolve_knobs(method, preset, explicit)
-    if values["output_length"] is None:
-        values["output_length"] = PRESETS[preset].output_length(lengths)
-    longest = int(np.max(lengths))
-    if values.get("sinc_window") is not None and values["sinc_window"] > longest:
-        values["sinc_window"] = longest  # a window wider than the series reads no more data
     if given_start:
         values["warp_start"] = "given"
     # the knobs; those of other methods (TTW's network, RTW's sine terms) are None
@@ -231,11 +222,39 @@ def resolve_config(
     )
 
 
+def size_config(config: AlignmentConfig, lengths: Any) -> AlignmentConfig:
+    """``config`` for series of these ``lengths``: the output length by the preset's rule
+    when not given, the sinc window no wider than the longest series (a wider one reads
+    no more data).
+
+    Parameters
+    ----------
+    config : AlignmentConfig
+    lengths : array-like of int
+        Lengths of the series averaged together.
+
+    Returns
+    -------
+    AlignmentConfig
+    """
+    changes: dict[str, Any] = {}
+    if config.output_length is None:
+        changes["output_length"] = PRESETS[config.preset].output_length(lengths)
+    longest = int(np.max(lengths))
+    if config.sinc_window is not None and config.sinc_window > longest:
+        changes["sinc_window"] = longest
+    return replace(config, **changes) if changes else config
+
+
 #: The fields of :class:`AlignmentConfig` that hold a knob's value.
 _KNOB_FIELDS = tuple(f.name for f in fields(AlignmentConfig) if f.name in KNOBS)
 
 
 # ------------------------------------------------------------------ docs tables
+#: The methods the knobs are declared for, in declaration order (the table's columns).
+_METHODS = tuple(dict.fromkeys(m for knob in KNOBS.values() for m in knob.methods))
+
+
 def _cell(value: Any) -> str:
     if value is None:
         return "None"
@@ -248,7 +267,7 @@ def presets_markdown() -> str:
     """The presets table of the user guide: the paper's value of every knob per method,
     and what each other preset changes."""
     others = [p for p in PRESETS if p != "paper"]
-    header = ["knob", " / ".join(METHOD_LABELS[m] for m in METHODS) + " (paper)", *others]
+    header = ["knob", " / ".join(m.upper() for m in _METHODS) + " (paper)", *others]
     lines = ["| " + " | ".join(header) + " |", "|" + " --- |" * len(header)]
     for name, knob in KNOBS.items():
         if name == "output_length":
@@ -256,7 +275,8 @@ def presets_markdown() -> str:
             cells += [PRESETS[p].output_length.formula for p in others]
             lines.append("| " + " | ".join([f"`{name}`", *cells]) + " |")
             continue
-        paper = " / ".join(_cell(knob.defaults[m]) if m in knob.defaults else "–" for m in METHODS)
+        paper = " / ".join(_cell(knob.defaults.get(m)) if m in knob.defaults else "–"
+                           for m in _METHODS)  # fmt: skip
         cells = [paper]
         for p in others:
             changed = {
@@ -271,17 +291,49 @@ def presets_markdown() -> str:
                 cells.append(values.pop())
             else:
                 cells.append(
-                    ", ".join(f"{METHOD_LABELS[m]}: {_cell(v)}" for m, v in changed.items())
+                    ", ".join(f"{m.upper()}: {_cell(v)}" for m, v in changed.items())
                 )
         lines.append("| " + " | ".join([f"`{name}`", *cells]) + " |")
     return "\n".join(lines)
+
+
+def settings_table(method: str, first: str) -> str:
+    """Every setting of ``method`` with its value under each preset, ``first`` first: an
+    reStructuredText table for the estimators' docstrings (``help()`` shows what runs).
+
+    Parameters
+    ----------
+    method : str
+        A method the knobs are declared for ("rtw", ..., "dba").
+    first : str
+        The preset shown first (the estimator's default).
+
+    Returns
+    -------
+    str
+    """
+    presets = [first, *(p for p in PRESETS if p != first)]
+    rows = [["setting", *(f'preset="{p}"' for p in presets)]]
+    for knob in method_knobs(method):
+        if knob.name == "output_length":
+            cells = [PRESETS[p].output_length.formula for p in presets]
+        else:
+            cells = [_cell(PRESETS[p].defaults(method)[knob.name]) for p in presets]
+        rows.append([f"``{knob.name}``", *cells])
+    widths = [max(len(row[i]) for row in rows) for i in range(len(rows[0]))]
+    rule = "  ".join("=" * w for w in widths)
+    lines = [rule, "  ".join(c.ljust(w) for c, w in zip(rows[0], widths, strict=True)).rstrip(),
+             rule]  # fmt: skip
+    lines += ["  ".join(c.ljust(w) for c, w in zip(row, widths, strict=True)).rstrip()
+              for row in rows[1:]]  # fmt: skip
+    return "\n".join([*lines, rule])
 
 
 def knobs_markdown() -> str:
     """The knobs table of the user guide: methods, accepted values, meaning."""
     lines = ["| knob | methods | accepts | meaning |", "| --- | --- | --- | --- |"]
     for name, knob in KNOBS.items():
-        methods = ", ".join(METHOD_LABELS[m] for m in knob.methods)
+        methods = ", ".join(m.upper() for m in knob.methods)
         accepts = knob.with_auto().type_doc().replace("|", "\\|")
         lines.append(f"| `{name}` | {methods} | {accepts} | {knob.doc} |")
     return "\n".join(lines)

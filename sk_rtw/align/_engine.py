@@ -10,7 +10,6 @@ early stop).
 
 from __future__ import annotations
 
-import inspect
 import sys
 import time
 from dataclasses import dataclass, field
@@ -27,7 +26,14 @@ from ..manifolds import Manifold
 from ..manifolds._mean import frechet_mean
 from ..utils import SeriesCollection, check_series_collection
 from ..utils._common_params import DTW_WINDOW, MANIFOLD, N_JOBS, RANDOM_STATE, VERBOSE
-from ..utils._params import AUTO, Declaration, Options, Parameter, Satisfies
+from ..utils._params import (
+    Declaration,
+    Options,
+    Parameter,
+    Satisfies,
+    check_signature_defaults,
+    drop_auto,
+)
 from ._config import (
     DEVICE_PARAMETER,
     PRESET_PARAMETER,
@@ -35,6 +41,7 @@ from ._config import (
     check_knobs,
     check_preset,
     resolve_config,
+    size_config,
 )
 from ._density import density_representatives
 from ._knobs import ENGINE_METHODS, KNOBS
@@ -107,7 +114,7 @@ class _Problem:
         self.layout = layout.to(device)
         self.data = torch.as_tensor(collection.data, dtype=torch.float64, device=device)
         self.lengths = torch.as_tensor(collection.lengths, device=device)
-        z = config.output_length
+        z = output_length(config)
         self.zhat = unit_time(z, device=device)
         self.loss_weights = window_weights(z, config.loss_window, config.loss_step, device=device)
         sizes = self.layout.sizes.to(torch.float64)
@@ -186,8 +193,15 @@ class _Problem:
         return group_loss.sum(), group_loss, warps, aligned, mean
 
 
+def output_length(config: AlignmentConfig) -> int:
+    """``config.output_length``, which the engine needs sized (:func:`size_config`)."""
+    if config.output_length is None:
+        raise ValueError("the configuration has no output length yet: size it with size_config")
+    return config.output_length
+
+
 def _is_engine_method(value: Any) -> bool:
-    return callable(getattr(value, "settings", None)) and getattr(value, "name", None) in (
+    return callable(getattr(value, "get_params", None)) and getattr(value, "name", None) in (
         ENGINE_METHODS
     )
 
@@ -286,7 +300,7 @@ def align(
         )
     method = ALIGN_METHOD.check(method)
     if not isinstance(method, str):  # a method object: its settings, then the keywords
-        settings = {**method.settings(), **settings}
+        settings = {**drop_auto(method.get_params(deep=False)), **settings}
         method = method.name
     preset = check_preset(preset)
     window = ALIGN_WINDOW.check(dtw_window)
@@ -304,8 +318,11 @@ def align(
     if given is not None and not isinstance(given, str):
         given_start = _check_warps(given, n_signals, explicit.get("output_length"))
         explicit["output_length"] = given_start.shape[1]
-    config = resolve_config(method, preset, explicit, collection.lengths, device=device_name,
-                            given_start=given_start is not None, dtw_window=window)  # fmt: skip
+    config = size_config(
+        resolve_config(method, preset, explicit, device=device_name,
+                       given_start=given_start is not None, dtw_window=window),
+        collection.lengths,
+    )  # fmt: skip
     seed = int(check_generator(random_state).integers(2**31 - 1))
     (result,) = align_collection(
         collection, np.zeros(n_signals, dtype=np.int64), [seed], config,
@@ -315,34 +332,21 @@ def align(
 
 
 def _align_docs() -> None:
-    """``align``'s signature and "Parameters" from the declarations (knobs included)."""
+    """``align``'s "Parameters" from the declarations, the knobs listed (the signature is
+    the written one: the knobs arrive in ``**settings``)."""
     own = Declaration(
         (MANIFOLD, ALIGN_METHOD, PRESET_PARAMETER, ALIGN_WINDOW, RANDOM_STATE,
          DEVICE_PARAMETER, N_JOBS, ALIGN_VERBOSE),
         {"manifold": "euclidean", "method": "rtw", "preset": "alignment", "dtw_window": None,
          "random_state": None, "device": "cpu", "n_jobs": None, "verbose": False},
     )  # fmt: skip
+    check_signature_defaults(align, own)
     knobs = [KNOBS[name] for name in KNOBS if set(KNOBS[name].methods) & set(ENGINE_METHODS)]
     listing = ", ".join(f"``{k.name}``" for k in knobs)
     doc = align.__doc__ or ""
     indent = "    "
     block = "\n".join(indent + line if line else line for line in own.docs().splitlines())
     align.__doc__ = doc.replace("    %(parameters)s", block).replace("%(knobs)s", listing)
-    parameters = [inspect.Parameter("X", inspect.Parameter.POSITIONAL_OR_KEYWORD)]
-    parameters += [
-        inspect.Parameter(p.name, inspect.Parameter.KEYWORD_ONLY, default=own.defaults[p.name])
-        for p in own.parameters[:3]
-    ]
-    parameters += [
-        inspect.Parameter(k.name, inspect.Parameter.KEYWORD_ONLY, default=AUTO) for k in knobs
-    ]
-    parameters += [
-        inspect.Parameter(p.name, inspect.Parameter.KEYWORD_ONLY, default=own.defaults[p.name])
-        for p in own.parameters[3:]
-    ]
-    align.__signature__ = inspect.Signature(  # type: ignore[attr-defined]
-        parameters, return_annotation="Alignment"
-    )
 
 
 _align_docs()
@@ -400,7 +404,7 @@ def align_collection(
         )
     work = (
         collection.n_series
-        * config.output_length
+        * output_length(config)
         * collection.data[0, 0].size
         * (collection.max_length if config.sinc_window is None else 2 * config.sinc_window + 1)
     )
@@ -411,7 +415,7 @@ def align_collection(
             given_start = dtw_start(
                 collection,
                 layout,
-                config.output_length,
+                output_length(config),
                 config.dtw_rounds,
                 lambda warps: _finite(
                     problem.converged_mean(warps.to(problem.data.device)),
@@ -470,7 +474,7 @@ def _refined(problem: _Problem, collection: SeriesCollection, layout: GroupLayou
     config, manifold = problem.config, collection.manifold
     band = -1.0 if config.dtw_window is None else float(config.dtw_window)
     means = mean.cpu().numpy().copy()
-    warps = np.empty((layout.n_series, config.output_length))
+    warps = np.empty((layout.n_series, output_length(config)))
     for g in range(layout.n_groups):
         members = layout.members(g)
         series = [collection.series(i) for i in members]
@@ -510,7 +514,7 @@ def estimated_memory(
     of window vectors; the network's activations at its evaluation times.
     """
     n_series, t_max = collection.n_series, collection.max_length
-    z = config.output_length
+    z = output_length(config)
     point = max(1, collection.data[0, 0].size)
     curved = not collection.manifold.is_flat
     steps = config.mean_iterations if config.mean_start == "first" else 1
@@ -548,7 +552,7 @@ def check_memory(collection: SeriesCollection, config: AlignmentConfig, n_groups
             "memory available: lower hidden_size (the paper's is 512)"
         )
     raise MemoryError(
-        f"aligning {collection.n_series} series to output_length Z={config.output_length} "
+        f"aligning {collection.n_series} series to output_length Z={output_length(config)} "
         f"needs about {format_bytes(need)}, more than the {format_bytes(free)} of memory "
         "available: lower output_length (the paper preset uses N T_max), align fewer "
         "series at once, or use warp_knots"

@@ -18,10 +18,10 @@ from ..utils._params import Boolean, Constant, Interval, Options, Parameter
 from ._start import START_AXES
 from ._warps import INITS
 
-#: The alignment engine's methods (one optimisation loop, three configurations).
+#: The alignment engine's methods (one optimisation loop, three configurations). The
+#: estimators' averaging methods, these and DBA, are registered in
+#: :data:`sk_rtw.methods.METHODS`.
 ENGINE_METHODS = ("rtw", "ttw", "ntw")
-#: Every averaging method of the estimators: the engine's and DTW barycenter averaging.
-METHODS = (*ENGINE_METHODS, "dba")
 
 WARP_STARTS = ("identity", "dtw")
 MEAN_STARTS = ("first", "previous")
@@ -184,8 +184,9 @@ KNOBS: dict[str, Knob] = {
         Knob(
             "tol",
             (Interval(float, 0.0),),
-            "Relative improvement of the objective that counts as progress (RTW, TTW, "
-            "NTW: for n_iter_no_change; DBA: it stops at the first iteration below it).",
+            "Relative improvement of the method's objective that counts as progress (RTW, "
+            "TTW, NTW: the training loss, for n_iter_no_change; DBA: the DTW cost, it stops "
+            "at the first iteration below it).",
             {**_every(1e-4), "dba": 1e-5},
         ),
         Knob(

@@ -176,9 +176,10 @@ class NeuralWarps(nn.Module):
     groups : int, sequence of int or GroupLayout
         Number of series (one group), the size of every group, or the layout of the
         stacked series.
-    hidden : int, default=512
-        Width ``H`` of the two hidden layers.
-    init : {"xavier", "zeros", "zero-readout"}, default="xavier"
+    hidden : int
+        Width ``H`` of the two hidden layers (the ``hidden_size`` knob).
+    init : {"xavier", "zeros", "zero-readout"}
+        The ``init`` knob.
     knots : int or None, default=None
         Evaluate the network at this many equally spaced times and interpolate linearly
         (None: at every output time).
@@ -190,8 +191,8 @@ class NeuralWarps(nn.Module):
     def __init__(
         self,
         groups: int | Sequence[int] | GroupLayout,
-        hidden: int = 512,
-        init: str = "xavier",
+        hidden: int,
+        init: str,
         knots: int | None = None,
         seeds: Sequence[int] | None = None,
         dtype=torch.float64,
@@ -308,13 +309,14 @@ class SineWarps(nn.Module):
     ----------
     groups : int, sequence of int or GroupLayout
         Number of series (one group), the size of every group, or the layout.
-    n_components : int, default=8
+    n_components : int
+        Sine terms K (the ``n_components`` knob).
     """
 
     def __init__(
         self,
         groups: int | Sequence[int] | GroupLayout,
-        n_components: int = 8,
+        n_components: int,
         dtype=torch.float64,
     ):
         super().__init__()

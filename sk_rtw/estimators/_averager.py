@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from typing import Any
+from dataclasses import replace
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from sklearn.base import BaseEstimator, TransformerMixin
@@ -19,12 +20,20 @@ from ._core import _label, fit_centroids
 from ._params import (
     AVERAGER_DEFAULTS,
     AVERAGER_PARAMETERS,
+    document_settings,
     set_params_with_hints,
     setting_hint,
 )
 from ._selection import choose, partition
 
+if TYPE_CHECKING:
+    import torch
 
+    from ..manifolds import Manifold
+    from ..methods import AveragingMethod
+
+
+@document_settings
 @declare_parameters(AVERAGER_PARAMETERS, AVERAGER_DEFAULTS, hint=setting_hint)
 class RTWAverager(TransformerMixin, BaseEstimator):
     """Learn one Riemannian Time Warping mean per class (or several); transform to DTW
@@ -60,7 +69,7 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         when they differ in length (DBA on series of unequal lengths).
     centroid_classes_ : ndarray of shape (n_means,)
         Class index (into ``classes_``) of every entry of ``means_``.
-    alignments_ : list of Alignment or MultipleAlignment
+    alignments_ : list of Alignment or sk_rtw.baselines.MultipleAlignment
         Per entry of ``means_``: the method's result (mean, aligned series, warps, cost,
         iterations run, resolved ``config``; see :class:`sk_rtw.methods.AveragingResult`).
     assignments_ : ndarray of shape (n_series,)
@@ -86,6 +95,10 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         Length of the training series when they all have the same length (a
         scikit-learn convention; series of any length are accepted by ``transform``).
 
+    Notes
+    -----
+    %(method_settings)s
+
     Examples
     --------
     >>> import numpy as np
@@ -98,6 +111,29 @@ class RTWAverager(TransformerMixin, BaseEstimator):
     >>> RTWAverager(method="dba").fit(X, [0, 0, 1, 1]).means_.shape
     (2, 40, 1)
     """
+
+    def __init__(
+        self,
+        manifold: str | Manifold = "euclidean",
+        *,
+        method: str | AveragingMethod = "rtw",
+        preset: str = "class-means",
+        n_centroids: int | str = 1,
+        dtw_window: float | str | None = None,
+        n_jobs: int | None = None,
+        random_state: int | np.random.RandomState | np.random.Generator | None = None,
+        device: str | torch.device = "cpu",
+        verbose: bool | int = 0,
+    ) -> None:
+        self.manifold = manifold
+        self.method = method
+        self.preset = preset
+        self.n_centroids = n_centroids
+        self.dtw_window = dtw_window
+        self.n_jobs = n_jobs
+        self.random_state = random_state
+        self.device = device
+        self.verbose = verbose
 
     def set_params(self, **params):
         """Set parameters, scikit-learn's way; ``method__<setting>`` also works when
@@ -142,7 +178,11 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         """
         params = validate_parameters(self)
         method = get_method(params["method"])
-        method.settings()  # every setting of the method checked before any work
+        context = FitContext(
+            preset=params["preset"], device=params["device"], n_jobs=params["n_jobs"],
+            verbose=int(params["verbose"]),
+        )  # fmt: skip
+        config = method.configure(context)  # every setting checked and resolved, once
         collection = check_series_collection(X, self.manifold)
         if y is None:
             labels = np.zeros(collection.n_series, dtype=int)
@@ -165,10 +205,7 @@ class RTWAverager(TransformerMixin, BaseEstimator):
             else:  # the paper's protocol: one mean per class, no band
                 window = None if window == "auto" else window
                 n_centroids = 1 if n_centroids == "auto" else n_centroids
-        context = FitContext(
-            preset=params["preset"], dtw_window=window, device=params["device"],
-            n_jobs=params["n_jobs"], verbose=int(params["verbose"]),
-        )  # fmt: skip
+        context = replace(context, dtw_window=window)
         owner = type(self).__name__
         if n_centroids == 1:
             groups, owners = codes, np.arange(len(classes))
@@ -182,10 +219,10 @@ class RTWAverager(TransformerMixin, BaseEstimator):
             names = [f"{_label(classes[c])}/{r + 1}" for c, r in zip(owners, rank, strict=True)]
             kind = "centroid"
         seeds = check_random_state(self.random_state).randint(2**31 - 1, size=len(owners))
-        fits = fit_centroids(method, collection, groups, [int(s) for s in seeds], context,
-                             names=names, kind=kind, owner=owner)  # fmt: skip
+        fits = fit_centroids(method, config, collection, groups, [int(s) for s in seeds],
+                             context, names=names, kind=kind, owner=owner)  # fmt: skip
         self.classes_ = classes
-        self.method_ = method.name
+        self.method_ = method.label
         self.manifold_ = collection.manifold
         self.dtw_window_ = window
         self.n_centroids_ = n_centroids
@@ -247,6 +284,7 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         return tags
 
 
+@document_settings
 @declare_parameters(defaults={"method": "ttw"})
 class TTWAverager(RTWAverager):
     """Class means by Riemannian Trainable Time Warping (sine-series warps).
@@ -257,9 +295,39 @@ class TTWAverager(RTWAverager):
     Parameters
     ----------
     %(parameters)s
+
+    Notes
+    -----
+    %(method_settings)s
     """
 
+    def __init__(
+        self,
+        manifold: str | Manifold = "euclidean",
+        *,
+        method: str | AveragingMethod = "ttw",
+        preset: str = "class-means",
+        n_centroids: int | str = 1,
+        dtw_window: float | str | None = None,
+        n_jobs: int | None = None,
+        random_state: int | np.random.RandomState | np.random.Generator | None = None,
+        device: str | torch.device = "cpu",
+        verbose: bool | int = 0,
+    ) -> None:
+        super().__init__(
+            manifold,
+            method=method,
+            preset=preset,
+            n_centroids=n_centroids,
+            dtw_window=dtw_window,
+            n_jobs=n_jobs,
+            random_state=random_state,
+            device=device,
+            verbose=verbose,
+        )
 
+
+@document_settings
 @declare_parameters(defaults={"method": "ntw"})
 class NTWAverager(RTWAverager):
     """Class means by Riemannian Neural Time Warping (zero-initialised network, full sinc).
@@ -270,7 +338,36 @@ class NTWAverager(RTWAverager):
     Parameters
     ----------
     %(parameters)s
+
+    Notes
+    -----
+    %(method_settings)s
     """
+
+    def __init__(
+        self,
+        manifold: str | Manifold = "euclidean",
+        *,
+        method: str | AveragingMethod = "ntw",
+        preset: str = "class-means",
+        n_centroids: int | str = 1,
+        dtw_window: float | str | None = None,
+        n_jobs: int | None = None,
+        random_state: int | np.random.RandomState | np.random.Generator | None = None,
+        device: str | torch.device = "cpu",
+        verbose: bool | int = 0,
+    ) -> None:
+        super().__init__(
+            manifold,
+            method=method,
+            preset=preset,
+            n_centroids=n_centroids,
+            dtw_window=dtw_window,
+            n_jobs=n_jobs,
+            random_state=random_state,
+            device=device,
+            verbose=verbose,
+        )
 
 
 def _check_labels(y: Any, n_series: int, classification: bool) -> np.ndarray:

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from scipy.optimize import minimize_scalar
@@ -13,7 +13,19 @@ from sklearn.utils.validation import check_is_fitted
 
 from ..utils._params import declare_parameters
 from ._averager import RTWAverager, _check_labels, _encode
-from ._params import AVERAGER_DEFAULTS, AVERAGER_PARAMETERS, TEMPERATURE, setting_hint
+from ._params import (
+    AVERAGER_DEFAULTS,
+    AVERAGER_PARAMETERS,
+    TEMPERATURE,
+    document_settings,
+    setting_hint,
+)
+
+if TYPE_CHECKING:
+    import torch
+
+    from ..manifolds import Manifold
+    from ..methods import AveragingMethod
 
 
 def fit_temperature(distances: np.ndarray, labels: np.ndarray) -> float:
@@ -49,9 +61,10 @@ def fit_temperature(distances: np.ndarray, labels: np.ndarray) -> float:
     return math.exp(best.x)
 
 
+@document_settings
 @declare_parameters(
     (*AVERAGER_PARAMETERS, TEMPERATURE),
-    {**AVERAGER_DEFAULTS, "n_centroids": "auto", "dtw_window": "auto", "temperature": "auto"},
+    {**AVERAGER_DEFAULTS, "n_centroids": "auto", "dtw_window": "auto", "temperature": "fit"},
     hint=setting_hint,
     notes={
         "n_centroids": "A series gets the class of its nearest centroid (Petitjean et al., "
@@ -91,10 +104,10 @@ class RTWNearestCentroid(ClassifierMixin, RTWAverager):
     means_ : ndarray of shape (n_means, Z, *point_shape) or list of ndarray
         Every centroid, ``n_centroids_`` per class (fewer for a smaller class).
     centroid_classes_ : ndarray of shape (n_means,)
-        Class index of every entry of ``means_``; :meth:`transform` returns, per class,
-        the distance to its nearest centroid (``RTWAverager.transform`` gives every
-        centroid's).
-    alignments_ : list of Alignment or MultipleAlignment
+        Class index of every entry of ``means_``: the class of every column of
+        :meth:`transform` (one per centroid, as ``RTWAverager.transform``);
+        :meth:`class_distances` gives one column per class, the nearest centroid's.
+    alignments_ : list of Alignment or sk_rtw.baselines.MultipleAlignment
         One per entry of ``means_``.
     assignments_ : ndarray of shape (n_series,)
         Entry of ``means_`` each training series was averaged into.
@@ -111,6 +124,10 @@ class RTWNearestCentroid(ClassifierMixin, RTWAverager):
         The temperature used by :meth:`predict_proba`, fitted on the choice's held-out
         distances (on the training distances when nothing was chosen).
 
+    Notes
+    -----
+    %(method_settings)s
+
     Examples
     --------
     >>> import numpy as np
@@ -122,6 +139,31 @@ class RTWNearestCentroid(ClassifierMixin, RTWAverager):
     >>> clf.fit(X, ["sin"] * 2 + ["cos"] * 2).predict(X).tolist()
     ['sin', 'sin', 'cos', 'cos']
     """
+
+    def __init__(
+        self,
+        manifold: str | Manifold = "euclidean",
+        *,
+        method: str | AveragingMethod = "rtw",
+        preset: str = "class-means",
+        n_centroids: int | str = "auto",
+        dtw_window: float | str | None = "auto",
+        n_jobs: int | None = None,
+        random_state: int | np.random.RandomState | np.random.Generator | None = None,
+        device: str | torch.device = "cpu",
+        verbose: bool | int = 0,
+        temperature: float | str = "fit",
+    ) -> None:
+        self.manifold = manifold
+        self.method = method
+        self.preset = preset
+        self.n_centroids = n_centroids
+        self.dtw_window = dtw_window
+        self.n_jobs = n_jobs
+        self.random_state = random_state
+        self.device = device
+        self.verbose = verbose
+        self.temperature = temperature
 
     def fit(self, X: Any, y: Any = None):
         """Choose the band and the centroids, learn the centroids of every class (and the
@@ -143,7 +185,7 @@ class RTWNearestCentroid(ClassifierMixin, RTWAverager):
                 f"{type(self).__name__} requires y to be passed, but the target y is None"
             )
         held_out = self._fit_means(X, y, require_two_classes=True)
-        if not isinstance(self.temperature, str):  # "auto" was checked with the others
+        if not isinstance(self.temperature, str):  # "fit" was checked with the others
             self.temperature_ = float(self.temperature)
             return self
         finite = None if held_out is None else np.isfinite(held_out[0]).all(1)
@@ -153,13 +195,13 @@ class RTWNearestCentroid(ClassifierMixin, RTWAverager):
             distances, codes = held_out
             self.temperature_ = fit_temperature(distances[finite], codes[finite])
         else:
-            distances = self.transform(X)
+            distances = self.class_distances(X)
             _, codes = _encode(_check_labels(y, len(distances), True))
             self.temperature_ = fit_temperature(distances, codes)
         return self
 
-    def transform(self, X: Any) -> np.ndarray:
-        """Manifold-DTW distance of every series to every class (its nearest centroid).
+    def class_distances(self, X: Any) -> np.ndarray:
+        """Manifold-DTW distance of every series to every class: to its nearest centroid.
 
         Parameters
         ----------
@@ -169,8 +211,11 @@ class RTWNearestCentroid(ClassifierMixin, RTWAverager):
         Returns
         -------
         distances : ndarray of shape (n_series, n_classes)
+            Column ``k`` is the class ``classes_[k]``; with one centroid per class it equals
+            :meth:`transform` (which gives one column per centroid, as
+            ``RTWAverager.transform``).
         """
-        distances = super().transform(X)
+        distances = self.transform(X)
         owners = self.centroid_classes_
         if len(owners) == len(self.classes_):
             return distances
@@ -190,7 +235,7 @@ class RTWNearestCentroid(ClassifierMixin, RTWAverager):
         -------
         labels : ndarray of shape (n_series,)
         """
-        distances = self.transform(X)
+        distances = self.class_distances(X)
         return self.classes_[np.argmin(distances, axis=1)]
 
     def predict_proba(self, X: Any) -> np.ndarray:
@@ -205,7 +250,7 @@ class RTWNearestCentroid(ClassifierMixin, RTWAverager):
         -------
         proba : ndarray of shape (n_series, n_classes)
         """
-        distances = self.transform(X)
+        distances = self.class_distances(X)
         return softmax(-distances / self.temperature_, axis=1)
 
     def decision_function(self, X: Any) -> np.ndarray:
@@ -223,12 +268,13 @@ class RTWNearestCentroid(ClassifierMixin, RTWAverager):
             towards ``classes_[1]``.
         """
         check_is_fitted(self, "means_")
-        distances = self.transform(X)
+        distances = self.class_distances(X)
         if len(self.classes_) == 2:
             return distances[:, 0] - distances[:, 1]
         return -distances
 
 
+@document_settings
 @declare_parameters(defaults={"method": "ttw"})
 class TTWNearestCentroid(RTWNearestCentroid):
     """Nearest-centroid classifier on Riemannian TTW class means.
@@ -239,9 +285,41 @@ class TTWNearestCentroid(RTWNearestCentroid):
     Parameters
     ----------
     %(parameters)s
+
+    Notes
+    -----
+    %(method_settings)s
     """
 
+    def __init__(
+        self,
+        manifold: str | Manifold = "euclidean",
+        *,
+        method: str | AveragingMethod = "ttw",
+        preset: str = "class-means",
+        n_centroids: int | str = "auto",
+        dtw_window: float | str | None = "auto",
+        n_jobs: int | None = None,
+        random_state: int | np.random.RandomState | np.random.Generator | None = None,
+        device: str | torch.device = "cpu",
+        verbose: bool | int = 0,
+        temperature: float | str = "fit",
+    ) -> None:
+        super().__init__(
+            manifold,
+            method=method,
+            preset=preset,
+            n_centroids=n_centroids,
+            dtw_window=dtw_window,
+            n_jobs=n_jobs,
+            random_state=random_state,
+            device=device,
+            verbose=verbose,
+            temperature=temperature,
+        )
 
+
+@document_settings
 @declare_parameters(defaults={"method": "ntw"})
 class NTWNearestCentroid(RTWNearestCentroid):
     """Nearest-centroid classifier on Riemannian NTW class means.
@@ -252,4 +330,35 @@ class NTWNearestCentroid(RTWNearestCentroid):
     Parameters
     ----------
     %(parameters)s
+
+    Notes
+    -----
+    %(method_settings)s
     """
+
+    def __init__(
+        self,
+        manifold: str | Manifold = "euclidean",
+        *,
+        method: str | AveragingMethod = "ntw",
+        preset: str = "class-means",
+        n_centroids: int | str = "auto",
+        dtw_window: float | str | None = "auto",
+        n_jobs: int | None = None,
+        random_state: int | np.random.RandomState | np.random.Generator | None = None,
+        device: str | torch.device = "cpu",
+        verbose: bool | int = 0,
+        temperature: float | str = "fit",
+    ) -> None:
+        super().__init__(
+            manifold,
+            method=method,
+            preset=preset,
+            n_centroids=n_centroids,
+            dtw_window=dtw_window,
+            n_jobs=n_jobs,
+            random_state=random_state,
+            device=device,
+            verbose=verbose,
+            temperature=temperature,
+        )

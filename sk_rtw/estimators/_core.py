@@ -36,6 +36,7 @@ def _label(name: Any) -> Any:
 
 def fit_centroids(
     method: AveragingMethod,
+    config: Any,
     collection: SeriesCollection,
     codes: np.ndarray,
     seeds: list[int],
@@ -51,7 +52,8 @@ def fit_centroids(
     Parameters
     ----------
     method : AveragingMethod
-        A checked method object.
+    config
+        ``method.configure(context)``: its settings, checked and resolved once per fit.
     collection : SeriesCollection
     codes : ndarray of int, shape (N,)
         Group of every series, ``0..n_groups - 1``, none empty.
@@ -76,14 +78,14 @@ def fit_centroids(
     n_groups = int(codes.max()) + 1
     names = list(range(n_groups)) if names is None else names
     start = time.perf_counter()
-    fitted = method.fit_groups(collection, codes, seeds, context, starts)
+    fitted = method.fit_groups(collection, codes, seeds, config, context, starts)
     if context.verbose:
         seconds = time.perf_counter() - start
         sizes = np.bincount(codes, minlength=n_groups)
         # a line per class or cluster; a line per centroid only at verbose >= 2
         for g in range(n_groups if kind != "centroid" or context.verbose >= 2 else 0):
             print(
-                f"[{owner}] {kind} {_label(names[g])!r}: {sizes[g]} series, {method.name}, "
+                f"[{owner}] {kind} {_label(names[g])!r}: {sizes[g]} series, {method.label}, "
                 f"{method.describe(fitted[g])}",
                 file=sys.stderr,
                 flush=True,
@@ -193,11 +195,12 @@ def kmeans(
     problems: np.ndarray,
     n_clusters: list[int],
     method: AveragingMethod,
+    config: Any,
     context: FitContext,
     rngs: list[np.random.RandomState],
     *,
-    max_iter: int = 10,
-    tol: float = 1e-4,
+    max_iter: int,
+    tol: float,
     init_label: str = "",
     owner: str = "RTWAverager",
 ) -> list[Clustering]:
@@ -211,12 +214,14 @@ def kmeans(
     n_clusters : list of int
         Clusters of every problem (at most its number of series).
     method : AveragingMethod
-        A checked method object: how every cluster is averaged.
+        How every cluster is averaged.
+    config
+        ``method.configure(context)``.
     context : FitContext
     rngs : list of numpy.random.RandomState
         One per problem: seeding and the seeds of the centroid fits.
-    max_iter : int, default=10
-    tol : float, default=1e-4
+    max_iter : int
+    tol : float
         A problem stops when no series changes cluster, or when its inertia improves by
         less than this fraction with no cluster re-seeded.
 
@@ -250,8 +255,8 @@ def kmeans(
         codes = np.concatenate([run.labels + offsets[i] for i, run in enumerate(active)])
         seeds = [int(run.rng.randint(2**31 - 1)) for run in active for _ in range(run.n_clusters)]
         starts = [c for run in active for c in run.centroids]  # warm starts (DBA)
-        fitted = fit_centroids(method, collection.subset(stacked), codes, seeds, context,
-                               kind="cluster", owner=owner, starts=starts)  # fmt: skip
+        fitted = fit_centroids(method, config, collection.subset(stacked), codes, seeds,
+                               context, kind="cluster", owner=owner, starts=starts)  # fmt: skip
         for i, (run, filled) in enumerate(zip(active, refilled, strict=True)):
             run.fits = fitted[offsets[i] : offsets[i + 1]]
             run.centroids = [fit.mean for fit in run.fits]

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from sklearn.base import BaseEstimator, ClusterMixin, TransformerMixin
@@ -21,9 +21,16 @@ from ._params import (
     N_CLUSTERS,
     N_INIT,
     TOL,
+    document_settings,
     set_params_with_hints,
     setting_hint,
 )
+
+if TYPE_CHECKING:
+    import torch
+
+    from ..manifolds import Manifold
+    from ..methods import AveragingMethod
 
 KMEANS_PARAMETERS = (
     N_CLUSTERS, METHOD, MANIFOLD, PRESET_PARAMETER, N_INIT, MAX_ITER, TOL, DTW_WINDOW,
@@ -45,6 +52,7 @@ KMEANS_DEFAULTS = {
 }
 
 
+@document_settings
 @declare_parameters(
     KMEANS_PARAMETERS, KMEANS_DEFAULTS, hint=setting_hint,
     notes={
@@ -83,13 +91,17 @@ class RTWKMeans(ClusterMixin, TransformerMixin, BaseEstimator):
         Sum over the training series of the squared distance to their centroid.
     n_iter_ : int
         Rounds run by the kept seeding (its best iterate is returned).
-    alignments_ : list of Alignment or MultipleAlignment
+    alignments_ : list of Alignment or sk_rtw.baselines.MultipleAlignment
         The averaging method's result of every cluster (as :class:`RTWAverager`'s): the
         series averaged into each centre, i.e. the assignment before the last round, which
         can differ from ``labels_`` (the nearest centre) where that round moved series.
     manifold_ : Manifold
     n_features_in_ : int
         Length of the training series when they are univariate of one length.
+
+    Notes
+    -----
+    %(method_settings)s
 
     Examples
     --------
@@ -103,6 +115,35 @@ class RTWKMeans(ClusterMixin, TransformerMixin, BaseEstimator):
     >>> labels[:3] == [labels[0]] * 3 and labels[3:] == [labels[3]] * 3 != labels[:3]
     True
     """
+
+    def __init__(
+        self,
+        n_clusters: int = 3,
+        *,
+        method: str | AveragingMethod = "rtw",
+        manifold: str | Manifold = "euclidean",
+        preset: str = "class-means",
+        n_init: int = 1,
+        max_iter: int = 10,
+        tol: float = 1e-4,
+        dtw_window: float | None = None,
+        n_jobs: int | None = None,
+        random_state: int | np.random.RandomState | np.random.Generator | None = None,
+        device: str | torch.device = "cpu",
+        verbose: bool | int = 0,
+    ) -> None:
+        self.n_clusters = n_clusters
+        self.method = method
+        self.manifold = manifold
+        self.preset = preset
+        self.n_init = n_init
+        self.max_iter = max_iter
+        self.tol = tol
+        self.dtw_window = dtw_window
+        self.n_jobs = n_jobs
+        self.random_state = random_state
+        self.device = device
+        self.verbose = verbose
 
     def set_params(self, **params):
         """Set parameters, scikit-learn's way; ``method__<setting>`` also works when
@@ -136,11 +177,11 @@ class RTWKMeans(ClusterMixin, TransformerMixin, BaseEstimator):
         """
         params = validate_parameters(self)
         method = get_method(params["method"])
-        method.settings()  # every setting of the method checked before any work
         self._context = FitContext(
             preset=params["preset"], dtw_window=params["dtw_window"], device=params["device"],
             n_jobs=params["n_jobs"], verbose=int(params["verbose"]),
         )  # fmt: skip
+        config = method.configure(self._context)  # every setting checked and resolved, once
         collection = check_series_collection(X, self.manifold)
         n_clusters = params["n_clusters"]
         if collection.n_series < n_clusters:
@@ -152,7 +193,7 @@ class RTWKMeans(ClusterMixin, TransformerMixin, BaseEstimator):
         best = None
         for run in range(params["n_init"]):
             (outcome,) = kmeans(
-                collection, problem, [n_clusters], method, self._context, [rng],
+                collection, problem, [n_clusters], method, config, self._context, [rng],
                 max_iter=params["max_iter"], tol=params["tol"],
                 init_label=f"init {run + 1}/{params['n_init']} ", owner="RTWKMeans",
             )  # fmt: skip

@@ -7,43 +7,45 @@ of a method (the engine's knobs, DBA's iterations) lives in the method object
 
 from __future__ import annotations
 
-from ..align._config import DEVICE_PARAMETER, METHOD_LABELS, PRESET_PARAMETER
+from ..align._config import DEVICE_PARAMETER, PRESET_PARAMETER, settings_table
 from ..align._knobs import owners
-from ..methods._base import method_parameter
+from ..methods._registry import METHODS, method_parameter
 from ..utils._common_params import DTW_WINDOW as BAND
 from ..utils._common_params import MANIFOLD, N_JOBS, RANDOM_STATE, VERBOSE
-from ..utils._params import Interval, Options, Parameter
+from ..utils._params import Interval, Options, Parameter, doc_indent, indent
 
 METHOD = method_parameter(
     'Averaging method: "rtw", "ttw", "ntw", "dba" (DTW barycenter averaging with Fréchet '
-    "means, any manifold), or a method object holding settings, e.g. "
-    "RTW(hidden_size=64), searchable as method__hidden_size. A name is the object with "
-    'every setting "auto" (the preset\'s value).'
+    "means, any manifold), or a method object: a shipped one holding settings, e.g. "
+    "RTW(hidden_size=64), searchable as method__hidden_size, or an AveragingMethod of your "
+    'own. A name is the object with every setting "auto" (the preset\'s value).'
 )
 N_CENTROIDS = Parameter(
     "n_centroids",
     (Interval(int, 1), Options(("auto",))),
     "Centroids per class. Above 1 each class is split into that many parts by k-medoids "
     "on the DTW matrix of its series (band ``dtw_window``; at most one part per series) "
-    'and every part is averaged once. "auto": chosen from the training data with the '
-    "band (fitted ``n_centroids_``, the scores in ``selection_``); one mean per class "
-    'under preset="paper".',
+    'and every part is averaged once. "auto": the preset\'s value, as for every "auto" of '
+    'the package: chosen from the training data with the band (fitted ``n_centroids_``, '
+    'the scores in ``selection_``) under "class-means" and "alignment", one mean per class '
+    'under "paper".',
 )
 DTW_WINDOW = Parameter(
     "dtw_window",
     (*BAND.constraints, Options(("auto",))),
     "Sakoe-Chiba band of every DTW of the fit (the DTW start of RTW, TTW and NTW, DBA, "
     "the partition into centroids) and of prediction, its radius as a fraction of the "
-    'shorter series\' length; None: no band. "auto": chosen from the training data with '
-    'the centroids (fitted ``dtw_window_``); no band under preset="paper".',
+    'shorter series\' length; None: no band. "auto": the preset\'s value: chosen from the '
+    'training data with the centroids (fitted ``dtw_window_``) under "class-means" and '
+    '"alignment", no band under "paper".',
 )
 TEMPERATURE = Parameter(
     "temperature",
-    (Interval(float, 0.0, closed="neither"), Options(("auto",))),
-    'Scale of the distances in predict_proba, softmax(-d / temperature). "auto" fits it '
-    "in fit by minimising the log-loss of the training series (raw DTW distances are in "
-    "the data's units: a fixed scale saturates or flattens); predictions do not depend "
-    "on it.",
+    (Interval(float, 0.0, closed="neither"), Options(("fit",))),
+    'Scale of the distances in predict_proba, softmax(-d / temperature). "fit": fitted in '
+    "fit by minimising the log-loss of the training series' held-out distances (raw DTW "
+    "distances are in the data's units: a fixed scale saturates or flattens); predictions "
+    "do not depend on it.",
 )
 N_CLUSTERS = Parameter("n_clusters", (Interval(int, 1),), "Number of clusters.")
 N_INIT = Parameter(
@@ -55,8 +57,10 @@ MAX_ITER = Parameter("max_iter", (Interval(int, 1),), "Most assignment/update ro
 TOL = Parameter(
     "tol",
     (Interval(float, 0.0),),
-    "Relative improvement of the inertia that counts as progress: a seeding stops at the "
-    "first round below it (or when no series changes cluster).",
+    "Relative improvement of the objective that counts as progress, as for every tol of "
+    "the package; here the objective is the inertia and a seeding stops at the first "
+    "round below it (or when no series changes cluster). The averaging method's own tol "
+    "(method=RTW(tol=...)) is the same rule for its own objective.",
 )
 
 #: The parameters of :class:`RTWAverager`, in signature order, with its defaults.
@@ -81,7 +85,7 @@ def setting_hint(name: str) -> str:
     """Where a keyword that is no estimator parameter belongs."""
     methods = owners(name)
     if methods:
-        label = METHOD_LABELS[methods[0]]
+        label = METHODS[methods[0]].__name__
         return (
             f"{name} is a setting of the averaging method: pass it there, "
             f"method={label}({name}=...), searchable as method__{name}"
@@ -112,3 +116,48 @@ def set_params_with_hints(estimator, params: dict, set_params) -> None:
                 f"{setting_hint(name)}. Valid parameters are: {sorted(own)}."
             )
     set_params(**params)
+
+
+#: Where :func:`document_settings` writes the default method's settings.
+SETTINGS_MARKER = "%(method_settings)s"
+
+
+def settings_notes(method: str, preset: str, chooses: bool = False) -> str:
+    """The "Notes" text of an estimator whose defaults are ``method`` and ``preset``: what
+    runs, and every setting of the method under each preset (from the knob and preset
+    records)."""
+    label = METHODS[method].__name__
+    text = [
+        f'What runs by default: ``method="{method}"``, i.e. :class:`~sk_rtw.{label}` with '
+        f'every setting ``"auto"``: the value of the preset (``preset="{preset}"`` unless '
+        f"set), listed below; a value given in the method object, "
+        f"``method={label}(n_epochs=64)``, replaces it. ``\"auto\"`` means the preset's "
+        "value everywhere in the package."
+    ]
+    if chooses:
+        text.append(
+            'The estimator\'s own ``"auto"`` values follow the same rule: under "class-means" '
+            'and "alignment" the band and the centroids per class are chosen from the '
+            'training data (``selection_``); under "paper" one mean per class and no band.'
+        )
+    wrapped = [line for paragraph in text for line in (*_wrap_text(paragraph), "")]
+    return "\n".join([*wrapped, settings_table(method, preset)])
+
+
+def _wrap_text(text: str) -> list[str]:
+    import textwrap
+
+    return textwrap.wrap(text, 84)
+
+
+def document_settings(cls):
+    """Class decorator (above :func:`~sk_rtw.utils._params.declare_parameters`): the
+    docstring's ``%(method_settings)s`` becomes :func:`settings_notes` for the class's
+    default method and preset."""
+    defaults = cls._declaration.defaults
+    chooses = "n_centroids" in defaults
+    if cls.__doc__ and SETTINGS_MARKER in cls.__doc__:
+        notes = settings_notes(defaults["method"], defaults["preset"], chooses)
+        block = indent(notes, doc_indent(cls.__doc__, SETTINGS_MARKER))
+        cls.__doc__ = cls.__doc__.replace(SETTINGS_MARKER, block.lstrip())
+    return cls

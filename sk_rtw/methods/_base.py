@@ -4,10 +4,12 @@ The estimators take their averaging method as ``method="rtw"`` (a shorthand) or 
 object, ``method=RTW(hidden_size=64)``: a small scikit-learn parameter container, so
 ``GridSearchCV`` reaches its settings as ``method__hidden_size`` the way a ``Pipeline``
 exposes its steps'. Every setting defaults to ``"auto"``, the preset's value; the preset
-itself is the estimator's (one argument for all methods). A method object checks its
-settings (:meth:`AveragingMethod.settings`), averages the groups of a stacked collection
-(:meth:`AveragingMethod.fit_groups`) and returns one result per group with the fields of
-:class:`AveragingResult`.
+itself is the estimator's (one argument for all methods). A method object checks and
+resolves its settings once per fit (:meth:`AveragingMethod.configure`: preset, then
+method, then the values given), averages the groups of a stacked collection with that
+configuration (:meth:`AveragingMethod.fit_groups`) and returns one result per group with
+the fields of :class:`AveragingResult`. A method of your own is a subclass with its own
+``__init__`` and ``fit_groups`` (see :class:`AveragingMethod`).
 """
 
 from __future__ import annotations
@@ -17,13 +19,12 @@ from dataclasses import dataclass
 from typing import Any, ClassVar, Protocol, runtime_checkable
 
 import numpy as np
-from sklearn.base import BaseEstimator, clone
+from sklearn.base import BaseEstimator
 
-from ..align._config import METHOD_LABELS, check_knobs
-from ..align._knobs import ENGINE_METHODS, METHODS, method_knobs, owners
+from ..align._knobs import ENGINE_METHODS, method_knobs, owners
 from ..manifolds import Manifold
 from ..utils import SeriesCollection
-from ..utils._params import AUTO, InstanceOf, Options, Parameter
+from ..utils._params import AUTO, validate_parameters
 
 
 @runtime_checkable
@@ -60,7 +61,9 @@ class FitContext:
     preset : str
         Name of the preset whose values ``"auto"`` settings take.
     dtw_window : float or None
-        Sakoe–Chiba band of the method's DTW (DBA), as a fraction of the series length.
+        Sakoe–Chiba band of the method's DTW (DBA, the DTW start), as a fraction of the
+        series length; applied in :meth:`AveragingMethod.fit_groups` (an estimator may
+        choose it from the data after :meth:`AveragingMethod.configure`).
     device : str
         Torch device of the engine's optimisation.
     n_jobs : int or None
@@ -79,11 +82,11 @@ class FitContext:
 def _knob_hint(method: str):
     def hint(name: str) -> str:
         others = owners(name)
-        label = METHOD_LABELS[method]
+        label = method.upper()
         mine = sorted(k.name for k in method_knobs(method))
         if others:
             return (
-                f"{name} is a setting of {', '.join(METHOD_LABELS[m] for m in others)}, not "
+                f"{name} is a setting of {', '.join(m.upper() for m in others)}, not "
                 f"of {label}; {label}'s settings are {mine}"
             )
         return f"{label}'s settings are {mine}"
@@ -92,36 +95,61 @@ def _knob_hint(method: str):
 
 
 class AveragingMethod(BaseEstimator):
-    """Base of the averaging methods (:class:`RTW`, :class:`TTW`, :class:`NTW`, :class:`DBA`).
+    """Base of the averaging methods: :class:`RTW`, :class:`TTW`, :class:`NTW`,
+    :class:`DBA`, and yours.
 
-    Subclasses are declared with their knobs (:func:`method_class`) and implement
-    :meth:`fit_groups`.
+    A method holds its settings as parameters (its written ``__init__`` stores them
+    unchanged, scikit-learn's rule), resolves them once per fit (:meth:`configure`) and
+    averages groups of series with that configuration (:meth:`fit_groups`). A subclass of
+    your own is a ``method=`` value of every estimator like the shipped ones: ``clone``,
+    ``get_params`` and ``GridSearchCV`` reach its settings as ``method__<setting>``. It
+    writes ``__init__`` and ``fit_groups``; :meth:`configure` by default returns its
+    parameters (checked first by the class's declaration, when it has one), and
+    :meth:`describe` the result's cost and iterations. See the user guide's "Averaging
+    methods" page for a complete example.
     """
 
-    #: Registry name of the method ("rtw", ...).
+    #: Short name of the method ("rtw", ...); a method of your own may leave it empty (its
+    #: class name is used in messages and in the estimators' ``method_``).
     name: ClassVar[str] = ""
+
+    @property
+    def label(self) -> str:
+        """The method's name as the estimators report it (``method_``)."""
+        return self.name or type(self).__name__
 
     def __eq__(self, other: object) -> bool:
         """Value equality, as for manifolds: the same method with the same settings."""
         return type(self) is type(other) and self.get_params() == other.get_params()  # type: ignore[attr-defined]
 
     def __hash__(self) -> int:
-        return hash((type(self), tuple(sorted(self.get_params().items()))))
+        return hash((type(self), tuple(sorted(map(repr, self.get_params().items())))))
 
-    def settings(self) -> dict[str, Any]:
-        """The settings given explicitly, checked, in canonical form (``"auto"`` dropped).
+    def configure(self, context: FitContext) -> Any:
+        """Check every setting and resolve it, once per fit: the configuration that
+        :meth:`fit_groups` receives.
+
+        Parameters
+        ----------
+        context : FitContext
+            The estimator's preset, band, device, threads and verbosity.
 
         Returns
         -------
-        dict
-            Knob name to value.
+        config
+            The shipped methods return a frozen record (``AlignmentConfig`` for RTW, TTW
+            and NTW, :class:`DBAConfig` for DBA) with every value the fit will use; the
+            default returns the parameters by name, canonical where the class declares
+            them.
 
         Raises
         ------
         InvalidParameterError
             Naming the setting and what it accepts.
         """
-        return check_knobs(self.name, self.get_params(deep=False), owner=type(self).__name__)
+        if getattr(type(self), "_declaration", None) is not None:
+            return validate_parameters(self)
+        return self.get_params(deep=False)
 
     @abstractmethod
     def fit_groups(
@@ -129,6 +157,7 @@ class AveragingMethod(BaseEstimator):
         collection: SeriesCollection,
         codes: np.ndarray,
         seeds: list[int],
+        config: Any,
         context: FitContext,
         starts: list[np.ndarray] | None = None,
     ) -> list[Any]:
@@ -137,14 +166,18 @@ class AveragingMethod(BaseEstimator):
         Parameters
         ----------
         collection : SeriesCollection
+            The series of every group (``collection.series(i)``, ``collection.subset``,
+            ``collection.manifold``).
         codes : ndarray of int, shape (N,)
             Group of every series, ``0..n_groups - 1``, none empty.
         seeds : list of int
             One seed per group.
+        config
+            What :meth:`configure` returned for this fit.
         context : FitContext
         starts : list of ndarray, optional
             A current average of every group (k-means' previous centroids), for methods
-            that iterate from one (DBA); the engine's methods start from their own.
+            that iterate from one (DBA); others may ignore it.
 
         Returns
         -------
@@ -158,18 +191,17 @@ class AveragingMethod(BaseEstimator):
 
 
 def method_class(method: str, summary: str):
-    """Class decorator: an :class:`AveragingMethod` named ``method`` with its knobs as
-    parameters, every one ``"auto"`` by default; the docstring is ``summary`` and the
-    knobs' documentation."""
+    """Class decorator: an :class:`AveragingMethod` named ``method`` whose parameters are
+    its knobs, every one ``"auto"`` by default (checked against the written
+    ``__init__``); the docstring is ``summary`` and the knobs' documentation."""
     from ..utils._params import declare_parameters
 
     knobs = [knob.with_auto() for knob in method_knobs(method)]
-    label = METHOD_LABELS[method]
     decorate = declare_parameters(
         knobs, dict.fromkeys((k.name for k in knobs), AUTO), positional=0,
         hint=_knob_hint(method),
     )  # fmt: skip
-
+    label = method.upper()
     where = " or of :func:`sk_rtw.align`" if method in ENGINE_METHODS else ""
 
     def build(cls):
@@ -185,41 +217,3 @@ def method_class(method: str, summary: str):
         return decorate(cls)
 
     return build
-
-
-def _registry() -> dict[str, type[AveragingMethod]]:
-    from ._dba import DBA
-    from ._engine import NTW, RTW, TTW
-
-    return {"rtw": RTW, "ttw": TTW, "ntw": NTW, "dba": DBA}
-
-
-def get_method(method: str | AveragingMethod) -> AveragingMethod:
-    """A fresh method object: the class named ``method`` with its defaults, or a clone.
-
-    Parameters
-    ----------
-    method : {"rtw", "ttw", "ntw", "dba"} or AveragingMethod
-
-    Returns
-    -------
-    AveragingMethod
-    """
-    if isinstance(method, AveragingMethod):
-        return clone(method)
-    name = Parameter("method", (Options(METHODS),), "").check(method)
-    return _registry()[name]()
-
-
-def method_parameter(doc: str) -> Parameter:
-    """The estimators' ``method`` parameter: a name or an :class:`AveragingMethod`."""
-    return Parameter(
-        "method",
-        (
-            Options(METHODS),
-            InstanceOf(
-                "AveragingMethod", "an AveragingMethod such as RTW()", types=(AveragingMethod,)
-            ),
-        ),
-        doc,
-    )

@@ -13,6 +13,7 @@ from joblib import Parallel, delayed
 from ..align._config import resolve_knobs
 from ..baselines import dba_average
 from ..utils import SeriesCollection
+from ..utils._params import drop_auto
 from ._base import AveragingMethod, FitContext, method_class
 
 
@@ -48,17 +49,41 @@ def _fit_one(collection: SeriesCollection, config: DBAConfig, init: Any = "medoi
     "    band is the estimator's ``dtw_window``.",
 )
 class DBA(AveragingMethod):
+    def __init__(
+        self,
+        *,
+        tol: float | str = "auto",
+        max_iter: int | str = "auto",
+    ) -> None:
+        self.tol = tol
+        self.max_iter = max_iter
+
+    def configure(self, context: FitContext) -> DBAConfig:
+        """Every setting checked and resolved (preset, then method, then the values given);
+        the estimator's band is applied by :meth:`fit_groups`.
+
+        Parameters
+        ----------
+        context : FitContext
+
+        Returns
+        -------
+        DBAConfig
+        """
+        given = drop_auto(super().configure(context))
+        values = resolve_knobs(self.name, context.preset, given)
+        return DBAConfig(self.name, context.preset, values["max_iter"], values["tol"], None)
+
     def fit_groups(
         self,
         collection: SeriesCollection,
         codes: np.ndarray,
         seeds: list[int],
+        config: DBAConfig,
         context: FitContext,
         starts: list[np.ndarray] | None = None,
     ) -> list[Any]:
-        values = resolve_knobs(self.name, context.preset, self.settings())
-        config = DBAConfig("dba", context.preset, values["max_iter"], values["tol"],
-                           context.dtw_window)  # fmt: skip
+        config = dataclasses.replace(config, window=context.dtw_window)
         codes = np.asarray(codes, dtype=np.int64)
         members = [np.flatnonzero(codes == g) for g in range(int(codes.max()) + 1)]
         inits = ["medoid"] * len(members) if starts is None else list(starts)

@@ -2,14 +2,15 @@
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Any
 
 import numpy as np
 
-from ..align._config import resolve_config
+from ..align._config import AlignmentConfig, resolve_config, size_config
 from ..align._engine import Alignment, align_collection
-from ..align._presets import PRESETS
 from ..utils import SeriesCollection
+from ..utils._params import drop_auto
 from ._base import AveragingMethod, FitContext, method_class
 
 
@@ -17,33 +18,47 @@ class EngineMethod(AveragingMethod):
     """A configuration of :func:`sk_rtw.align`'s engine; every group in one optimisation
     per distinct output length."""
 
+    def configure(self, context: FitContext) -> AlignmentConfig:
+        """Every setting checked and resolved (preset, then method, then the values given):
+        the engine's configuration, its output length left to the preset's rule
+        (``None``) unless given; the estimator's band is applied by :meth:`fit_groups`.
+
+        Parameters
+        ----------
+        context : FitContext
+
+        Returns
+        -------
+        AlignmentConfig
+        """
+        given = drop_auto(super().configure(context))
+        return resolve_config(self.name, context.preset, given, device=context.device)
+
     def fit_groups(
         self,
         collection: SeriesCollection,
         codes: np.ndarray,
         seeds: list[int],
+        config: AlignmentConfig,
         context: FitContext,
         starts: list[np.ndarray] | None = None,
     ) -> list[Any]:
-        explicit = self.settings()
+        config = dataclasses.replace(config, dtw_window=context.dtw_window)
         codes = np.asarray(codes, dtype=np.int64)
         n_groups = int(codes.max()) + 1
         lengths = collection.lengths
-        rule = PRESETS[context.preset].output_length
         z = np.array(
-            [explicit.get("output_length") or rule(lengths[codes == g]) for g in range(n_groups)]
+            [size_config(config, lengths[codes == g]).output_length for g in range(n_groups)]
         )
         fitted: list[Alignment | None] = [None] * n_groups
         for length in np.unique(z):
             groups = np.flatnonzero(z == length)
             members = np.flatnonzero(np.isin(codes, groups))
-            config = resolve_config(
-                self.name, context.preset, {**explicit, "output_length": int(length)},
-                lengths[members], device=context.device, dtw_window=context.dtw_window,
-            )  # fmt: skip
+            batch = size_config(dataclasses.replace(config, output_length=int(length)),
+                                lengths[members])  # fmt: skip
             results = align_collection(
                 collection.subset(members), np.searchsorted(groups, codes[members]),
-                [seeds[g] for g in groups], config, n_jobs=context.n_jobs,
+                [seeds[g] for g in groups], batch, n_jobs=context.n_jobs,
                 verbose=context.verbose >= 2,
             )  # fmt: skip
             for g, result in zip(groups, results, strict=True):
@@ -56,14 +71,151 @@ class EngineMethod(AveragingMethod):
 
 @method_class("rtw", "Riemannian Time Warping: neural warps, windowed sinc, Gaussian window loss.")
 class RTW(EngineMethod):
-    pass
+    def __init__(
+        self,
+        *,
+        output_length: int | str = "auto",
+        n_epochs: int | str = "auto",
+        learning_rate: float | str = "auto",
+        sinc_window: int | str | None = "auto",
+        loss_window: int | str = "auto",
+        loss_step: int | str = "auto",
+        penalty: float | str = "auto",
+        warp_start: str = "auto",
+        init: str = "auto",
+        hidden_size: int | str = "auto",
+        warp_knots: int | str | None = "auto",
+        tangent_refinements: int | str = "auto",
+        mean_iterations: int | str = "auto",
+        mean_start: str = "auto",
+        mean_weights: str = "auto",
+        dtw_rounds: int | str = "auto",
+        smoothing: float | str = "auto",
+        start_axis: str = "auto",
+        n_iter_no_change: int | str | None = "auto",
+        tol: float | str = "auto",
+        cuda_graph: bool | str = "auto",
+        refine_steps: int | str = "auto",
+    ) -> None:
+        self.output_length = output_length
+        self.n_epochs = n_epochs
+        self.learning_rate = learning_rate
+        self.sinc_window = sinc_window
+        self.loss_window = loss_window
+        self.loss_step = loss_step
+        self.penalty = penalty
+        self.warp_start = warp_start
+        self.init = init
+        self.hidden_size = hidden_size
+        self.warp_knots = warp_knots
+        self.tangent_refinements = tangent_refinements
+        self.mean_iterations = mean_iterations
+        self.mean_start = mean_start
+        self.mean_weights = mean_weights
+        self.dtw_rounds = dtw_rounds
+        self.smoothing = smoothing
+        self.start_axis = start_axis
+        self.n_iter_no_change = n_iter_no_change
+        self.tol = tol
+        self.cuda_graph = cuda_graph
+        self.refine_steps = refine_steps
 
 
 @method_class("ttw", "Riemannian Trainable Time Warping: sine-series warps, pointwise loss.")
 class TTW(EngineMethod):
-    pass
+    def __init__(
+        self,
+        *,
+        output_length: int | str = "auto",
+        n_epochs: int | str = "auto",
+        learning_rate: float | str = "auto",
+        sinc_window: int | str | None = "auto",
+        loss_window: int | str = "auto",
+        loss_step: int | str = "auto",
+        penalty: float | str = "auto",
+        warp_start: str = "auto",
+        n_components: int | str = "auto",
+        tangent_refinements: int | str = "auto",
+        mean_iterations: int | str = "auto",
+        mean_start: str = "auto",
+        mean_weights: str = "auto",
+        dtw_rounds: int | str = "auto",
+        smoothing: float | str = "auto",
+        start_axis: str = "auto",
+        n_iter_no_change: int | str | None = "auto",
+        tol: float | str = "auto",
+        cuda_graph: bool | str = "auto",
+        refine_steps: int | str = "auto",
+    ) -> None:
+        self.output_length = output_length
+        self.n_epochs = n_epochs
+        self.learning_rate = learning_rate
+        self.sinc_window = sinc_window
+        self.loss_window = loss_window
+        self.loss_step = loss_step
+        self.penalty = penalty
+        self.warp_start = warp_start
+        self.n_components = n_components
+        self.tangent_refinements = tangent_refinements
+        self.mean_iterations = mean_iterations
+        self.mean_start = mean_start
+        self.mean_weights = mean_weights
+        self.dtw_rounds = dtw_rounds
+        self.smoothing = smoothing
+        self.start_axis = start_axis
+        self.n_iter_no_change = n_iter_no_change
+        self.tol = tol
+        self.cuda_graph = cuda_graph
+        self.refine_steps = refine_steps
 
 
 @method_class("ntw", "Riemannian Neural Time Warping: zero-initialised network, full sinc.")
 class NTW(EngineMethod):
-    pass
+    def __init__(
+        self,
+        *,
+        output_length: int | str = "auto",
+        n_epochs: int | str = "auto",
+        learning_rate: float | str = "auto",
+        sinc_window: int | str | None = "auto",
+        loss_window: int | str = "auto",
+        loss_step: int | str = "auto",
+        penalty: float | str = "auto",
+        warp_start: str = "auto",
+        init: str = "auto",
+        hidden_size: int | str = "auto",
+        warp_knots: int | str | None = "auto",
+        tangent_refinements: int | str = "auto",
+        mean_iterations: int | str = "auto",
+        mean_start: str = "auto",
+        mean_weights: str = "auto",
+        dtw_rounds: int | str = "auto",
+        smoothing: float | str = "auto",
+        start_axis: str = "auto",
+        n_iter_no_change: int | str | None = "auto",
+        tol: float | str = "auto",
+        cuda_graph: bool | str = "auto",
+        refine_steps: int | str = "auto",
+    ) -> None:
+        self.output_length = output_length
+        self.n_epochs = n_epochs
+        self.learning_rate = learning_rate
+        self.sinc_window = sinc_window
+        self.loss_window = loss_window
+        self.loss_step = loss_step
+        self.penalty = penalty
+        self.warp_start = warp_start
+        self.init = init
+        self.hidden_size = hidden_size
+        self.warp_knots = warp_knots
+        self.tangent_refinements = tangent_refinements
+        self.mean_iterations = mean_iterations
+        self.mean_start = mean_start
+        self.mean_weights = mean_weights
+        self.dtw_rounds = dtw_rounds
+        self.smoothing = smoothing
+        self.start_axis = start_axis
+        self.n_iter_no_change = n_iter_no_change
+        self.tol = tol
+        self.cuda_graph = cuda_graph
+        self.refine_steps = refine_steps

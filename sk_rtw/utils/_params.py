@@ -1,14 +1,17 @@
 """Declared parameters: each one written once, and checked, signed and documented from that.
 
 A :class:`Parameter` is a name, the values it accepts (a tuple of :class:`Constraint`)
-and a one-line description with its unit. A class lists the parameters it takes with
-its own defaults (:func:`declare_parameters`); from that list come
+and a one-line description with its unit. A class writes its ``__init__`` by hand
+(parameters stored unchanged, scikit-learn's rule: static tools and IDEs see the real
+signature) and lists the parameters it takes with its defaults
+(:func:`declare_parameters`); from that list come
 
-* its ``__init__`` (keyword arguments stored unchanged, scikit-learn's rule; an unknown
-  name is a ``TypeError`` that says where the setting belongs),
+* the check that the written signature is the declared one (names, order, defaults,
+  which are keyword-only), made when the class is defined,
 * the check run once at the start of ``fit`` (:func:`validate_parameters`), in the shape
   of scikit-learn's ``_parameter_constraints`` (written here: that module is private),
-* the "Parameters" section of its docstring.
+* the "Parameters" section of its docstring,
+* for an unknown keyword, a ``TypeError`` that says where the setting belongs.
 
 String options are case-insensitive and come back lower-cased. ``"auto"`` is the one
 sentinel for "the preset's value" and ``None`` for "off" (no band, no early stop, ...).
@@ -16,12 +19,13 @@ sentinel for "the preset's value" and ``None`` for "off" (no band, no early stop
 
 from __future__ import annotations
 
+import functools
 import inspect
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from numbers import Integral, Real
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -194,12 +198,16 @@ class InstanceOf(_Described):
 
 @dataclass(frozen=True)
 class Satisfies(_Described):
-    """Any value for which ``predicate`` holds (for rules no interval states)."""
+    """Any value for which ``predicate`` holds (for rules no interval states); strings
+    come back lower-cased, as :class:`Options`'."""
 
     predicate: Callable[[Any], bool] = bool
 
     def accepts(self, value: Any) -> bool:
         return bool(self.predicate(value))
+
+    def normalise(self, name: str, value: Any) -> Any:
+        return value.lower() if isinstance(value, str) else value
 
 
 @dataclass(frozen=True)
@@ -306,6 +314,9 @@ def _wrap(text: str, width: int = 84) -> list[str]:
 PARAMETERS_MARKER = "%(parameters)s"
 
 
+_Class = TypeVar("_Class", bound=type)
+
+
 def declare_parameters(
     parameters: Sequence[Parameter] | None = None,
     defaults: Mapping[str, Any] | None = None,
@@ -313,8 +324,9 @@ def declare_parameters(
     positional: int = 1,
     hint: Callable[[str], str] | None = None,
     notes: Mapping[str, str] | None = None,
-):
-    """Class decorator: ``__init__``, the check table and the docs from ``parameters``.
+) -> Callable[[_Class], _Class]:
+    """Class decorator: the check table and the docs from ``parameters``, checked against
+    the class's written ``__init__``.
 
     Parameters
     ----------
@@ -331,10 +343,15 @@ def declare_parameters(
     notes : mapping, optional
         Class-specific text appended to a parameter's documentation.
 
+    Raises
+    ------
+    TypeError
+        When the class's own ``__init__`` is not the declared signature.
+
     The class docstring's ``%(parameters)s`` marker is replaced by the numpydoc entries.
     """
 
-    def decorate(cls):
+    def decorate(cls: _Class) -> _Class:
         parent = getattr(cls, "_declaration", None)
         if parameters is None:
             if parent is None:
@@ -348,47 +365,83 @@ def declare_parameters(
             if missing:
                 raise TypeError(f"{cls.__name__}: no default for {missing}")
             declaration = Declaration(tuple(parameters), dict(defaults or {}), positional, hint)
-        cls._declaration = declaration
-        cls.__init__ = _make_init(declaration)
+        check_signature(cls, declaration)
+        cls._declaration = declaration  # type: ignore[attr-defined]
+        cls.__init__ = _with_hint(cls.__dict__["__init__"], declaration)  # type: ignore[misc]
         if cls.__doc__ and PARAMETERS_MARKER in cls.__doc__:
-            block = _indent(declaration.docs(notes), _doc_indent(cls.__doc__))
+            block = indent(declaration.docs(notes), doc_indent(cls.__doc__))
             cls.__doc__ = cls.__doc__.replace(PARAMETERS_MARKER, block.lstrip())
         return cls
 
     return decorate
 
 
-def _doc_indent(doc: str) -> str:
+def check_signature(cls: type, declaration: Declaration) -> None:
+    """``TypeError`` unless ``cls`` writes its own ``__init__`` with exactly the declared
+    parameters: names, order, defaults and which may be passed by position."""
+    init = cls.__dict__.get("__init__")
+    if init is None:
+        raise TypeError(
+            f"{cls.__name__} must write its own __init__ (scikit-learn's rule: every "
+            "parameter a keyword of the class's signature)"
+        )
+
+    def shape(signature: inspect.Signature) -> list[tuple[str, Any, Any]]:
+        return [(p.name, p.kind, p.default) for p in signature.parameters.values()]
+
+    written, declared = shape(inspect.signature(init)), shape(declaration.signature())
+    if written != declared:
+        raise TypeError(
+            f"{cls.__name__}.__init__ differs from its declared parameters: written "
+            f"{inspect.signature(init)}, declared {declaration.signature()}"
+        )
+
+
+def check_signature_defaults(function: Callable[..., Any], declaration: Declaration) -> None:
+    """``TypeError`` unless every declared parameter is a keyword of ``function`` with the
+    declared default (a function's written signature against its declaration)."""
+    written = inspect.signature(function).parameters
+    for name, default in declaration.defaults.items():
+        if name not in written or written[name].default != default:
+            raise TypeError(
+                f"{function.__name__}'s signature differs from its declaration at {name!r}"
+            )
+
+
+def _with_hint(init: Callable[..., None], declaration: Declaration) -> Callable[..., None]:
+    """``init`` itself, except that an unknown keyword's ``TypeError`` says where the
+    setting belongs (the declaration's ``hint``)."""
+    if declaration.hint is None:
+        return init
+    names = set(declaration.names)
+
+    @functools.wraps(init)
+    def __init__(self: Any, *args: Any, **kwargs: Any) -> None:
+        unknown = [k for k in kwargs if k not in names]
+        if unknown:
+            text = f"{type(self).__name__}() got an unexpected keyword argument {unknown[0]!r}"
+            raise TypeError(f"{text}; {declaration.hint(unknown[0])}")  # type: ignore[misc]
+        init(self, *args, **kwargs)
+
+    return __init__
+
+
+def doc_indent(doc: str, marker: str = PARAMETERS_MARKER) -> str:
+    """The indentation of the docstring line holding ``marker``."""
     for line in doc.splitlines():
-        if PARAMETERS_MARKER in line:
+        if marker in line:
             return line[: len(line) - len(line.lstrip())]
     return ""
 
 
-def _indent(text: str, prefix: str) -> str:
+def indent(text: str, prefix: str) -> str:
+    """Every non-empty line of ``text`` prefixed."""
     return "\n".join(prefix + line if line else line for line in text.splitlines())
 
 
-def _make_init(declaration: Declaration):
-    signature = declaration.signature()
-    names = declaration.names
-
-    def __init__(self, *args, **kwargs):
-        unknown = [k for k in kwargs if k not in names]
-        if unknown:
-            owner = type(self).__name__
-            text = f"{owner}() got an unexpected keyword argument {unknown[0]!r}"
-            if declaration.hint is not None:
-                text += "; " + declaration.hint(unknown[0])
-            raise TypeError(text)
-        bound = signature.bind(self, *args, **kwargs)
-        bound.apply_defaults()
-        for name in names:
-            setattr(self, name, bound.arguments[name])
-
-    __init__.__signature__ = signature  # type: ignore[attr-defined]
-    __init__.__doc__ = "Store the parameters unchanged (checked in ``fit``)."
-    return __init__
+def drop_auto(values: Mapping[str, Any]) -> dict[str, Any]:
+    """``values`` without the entries left ``"auto"`` (the preset's value)."""
+    return {k: v for k, v in values.items() if not (isinstance(v, str) and v == AUTO)}
 
 
 def validate_parameters(obj: Any, names: Sequence[str] | None = None) -> dict[str, Any]:
