@@ -793,3 +793,22 @@ def test_density_weighted_alignment_and_its_gradient():
     assert np.nanmin(result.loss_history) <= result.loss_history[0]
     with pytest.raises(ValueError, match="mean_weights"):
         align(data.signals, mean_weights="counts")
+
+
+def test_the_engines_adam_is_torchs_fused_adam_bit_for_bit():
+    from sk_rtw.align._adam import FusedAdam
+
+    torch.manual_seed(0)
+    start = [torch.randn(5, 3, dtype=torch.float64), torch.randn(7, dtype=torch.float64)]
+    ours = [p.clone().requires_grad_() for p in start]
+    theirs = [p.clone().requires_grad_() for p in start]
+    mine, reference = FusedAdam(ours, lr=0.01), torch.optim.Adam(theirs, lr=0.01, fused=True)
+    for step in range(20):
+        for params, optimiser in ((ours, mine), (theirs, reference)):
+            optimiser.zero_grad(set_to_none=True)
+            loss = (params[0] ** 3).sum() + torch.sin(params[1]).sum() * (step + 1)
+            loss.backward()
+            optimiser.step()
+        for a, b in zip(ours, theirs, strict=True):
+            assert torch.equal(a, b), step
+    assert not torch.equal(ours[0], start[0])  # it moved

@@ -35,6 +35,8 @@ from collections.abc import Callable, Sequence
 import numpy as np
 import torch
 
+from ._adam import FusedAdam
+
 #: Eager epochs before a CUDA graph is captured (lets lazy allocations settle).
 WARMUP_EPOCHS = 3
 
@@ -86,10 +88,9 @@ class Trainer:
         device = parameters[0].device
         self.device = device
         self.cuda = device.type == "cuda"
-        # fused Adam: one kernel for all parameters (CPU and CUDA alike)
-        self.optimiser = torch.optim.Adam(
-            parameters, lr=learning_rate, fused=True, capturable=self.cuda
-        )
+        # fused Adam: one kernel for all parameters (CPU and CUDA alike), torch.optim's
+        # kernel without its first-call import of torch._dynamo (see _adam.py)
+        self.optimiser = FusedAdam(parameters, lr=learning_rate)
         dtype = parameters[0].dtype
         if parameter_groups is None:
             parameter_groups = [torch.zeros(p.shape[0] if p.ndim else 1, dtype=torch.long)
