@@ -1,0 +1,177 @@
+"""What a fresh Python process pays: import, the first call against the next ones, and a
+parallel grid search.
+
+Usage::
+
+    python benchmarks/first_call.py                 # every probe, 3 fresh processes each
+    python benchmarks/first_call.py --probes align --repeat 5
+
+Every probe runs in fresh interpreters (``sys.executable``), as a user meets the library:
+
+* ``align``: ``import sk_rtw``, then :func:`sk_rtw.align` three times on the same 8
+  unit-quaternion series (T = 50 and T = 1,000), the default settings; the first call
+  against the median of the other two is the one-time cost;
+* ``split``: the first ``align`` (T = 50) under cProfile, its time divided into numba
+  kernels loaded from the cache (``Dispatcher._compile_for_args``), imports made during
+  the call, the first epoch (``Trainer.step``'s first call, minus the above), and the rest
+  (profiling slows everything a little: read it as proportions);
+* ``search``: ``GridSearchCV(RTWNearestCentroid(n_centroids=1, dtw_window=None), cv=3)``
+  over RTW's ``hidden_size`` and DBA on aeon's GunPoint (its training split), with
+  ``n_jobs=1`` and ``n_jobs=2`` (joblib's default process workers), each searched twice in
+  the same process: the second search reuses the workers.
+
+Prints one Markdown table per probe with the median over ``--repeat`` processes.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import subprocess
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the repository; then _shared
+
+from benchmarks._shared import machine, positive_int
+
+ALIGN = """
+import json, time
+t = time.perf_counter()
+import sk_rtw
+imported = time.perf_counter() - t
+import numpy as np
+from sk_rtw.datasets import make_warped_signals
+out = {"import": imported}
+for T in (50, 1000):
+    X = np.asarray(make_warped_signals("quaternion", 8, T, random_state=0).signals)
+    calls = []
+    for _ in range(3):
+        t = time.perf_counter()
+        sk_rtw.align(X, manifold="quaternion", random_state=0)
+        calls.append(time.perf_counter() - t)
+    out[T] = calls
+print(json.dumps(out))
+"""
+
+SPLIT = """
+import cProfile, json, pstats, time
+import numpy as np
+import sk_rtw
+from sk_rtw.align import _training
+from sk_rtw.datasets import make_warped_signals
+X = np.asarray(make_warped_signals("quaternion", 8, 50, random_state=0).signals)
+first = {}
+step = _training.Trainer.step
+def timed(self, *args, **kwargs):
+    if "epoch" not in first:
+        t = time.perf_counter()
+        step(self, *args, **kwargs)
+        first["epoch"] = time.perf_counter() - t
+    else:
+        step(self, *args, **kwargs)
+_training.Trainer.step = timed
+profile = cProfile.Profile()
+t = time.perf_counter()
+profile.enable()
+sk_rtw.align(X, manifold="quaternion", random_state=0)
+profile.disable()
+total = time.perf_counter() - t
+stats = pstats.Stats(profile).stats
+def cumulative(predicate):
+    return sum(v[3] for k, v in stats.items() if predicate(k))
+kernels = cumulative(lambda k: k[2] == "_compile_for_args")
+imports = cumulative(lambda k: k[2] == "_find_and_load")
+print(json.dumps({"total": total, "kernels": kernels, "imports": imports,
+                  "first epoch": first.get("epoch", 0.0)}))
+"""
+
+SEARCH = """
+import json, sys, time
+from aeon.datasets import load_classification
+from sklearn.model_selection import GridSearchCV
+from sk_rtw import DBA, RTW, RTWNearestCentroid
+X, y = load_classification("GunPoint", split="train")
+X = X[:, 0, :]
+grid = [{"method": [RTW()], "method__hidden_size": [16, 64]}, {"method": [DBA()]}]
+times = []
+for _ in range(2):
+    t = time.perf_counter()
+    GridSearchCV(RTWNearestCentroid(n_centroids=1, dtw_window=None, random_state=0),
+                 grid, cv=3, n_jobs=int(sys.argv[1])).fit(X, y)
+    times.append(time.perf_counter() - t)
+print(json.dumps(times))
+"""
+
+
+def fresh(code: str, *args: str) -> dict:
+    """Run ``code`` in a new interpreter; its last printed line, as JSON."""
+    done = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True,
+                          check=False)  # fmt: skip
+    if done.returncode != 0:
+        raise SystemExit(f"a probe failed:\n{done.stderr[-2000:]}")
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def median(values) -> float:
+    return statistics.median(values)
+
+
+def probe_align(repeat: int) -> str:
+    runs = [fresh(ALIGN) for _ in range(repeat)]
+    lines = [
+        "| series | import sk_rtw (s) | first align (s) | second, third (median, s) | "
+        "first / later |",
+        "| --- | --- | --- | --- | --- |",
+    ]
+    for T in ("50", "1000"):
+        first = median([r[T][0] for r in runs])
+        later = median([median(r[T][1:]) for r in runs])
+        lines.append(f"| 8 x {T} quaternions | {median([r['import'] for r in runs]):.2f} | "
+                     f"{first:.2f} | {later:.2f} | {first / later:.2f}x |")  # fmt: skip
+    return "\n".join(lines)
+
+
+def probe_split(repeat: int) -> str:
+    runs = [fresh(SPLIT) for _ in range(repeat)]
+    total = median([r["total"] for r in runs])
+    kernels = median([r["kernels"] for r in runs])
+    imports = median([r["imports"] for r in runs])
+    epoch = median([r["first epoch"] for r in runs])
+    rest = total - kernels - imports - epoch
+    return (
+        "| first align, 8 x 50 (profiled) | kernels loaded | imports in the call | "
+        "first epoch | the rest |\n| --- | --- | --- | --- | --- |\n"
+        f"| {total:.2f} s | {kernels:.2f} s | {imports:.2f} s | {epoch:.2f} s | {rest:.2f} s |"
+    )
+
+
+def probe_search(repeat: int) -> str:
+    lines = [
+        "| GridSearchCV, 3 candidates x 3 folds | first search (s) | second search (s) |",
+        "| --- | --- | --- |",
+    ]
+    for n_jobs in ("1", "2"):
+        runs = [fresh(SEARCH, n_jobs) for _ in range(repeat)]
+        lines.append(f"| n_jobs={n_jobs} | {median([r[0] for r in runs]):.2f} | "
+                     f"{median([r[1] for r in runs]):.2f} |")  # fmt: skip
+    return "\n".join(lines)
+
+
+PROBES = {"align": probe_align, "split": probe_split, "search": probe_search}
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--probes", nargs="+", choices=list(PROBES), default=list(PROBES))
+    parser.add_argument("--repeat", type=positive_int, default=3,
+                        help="fresh processes per probe (median reported)")  # fmt: skip
+    args = parser.parse_args(argv)
+    print(f"# First calls\n\nMachine: {machine()}\n")
+    for name in args.probes:
+        print(f"## {name}\n\n{PROBES[name](args.repeat)}\n", flush=True)
+
+
+if __name__ == "__main__":
+    main()
