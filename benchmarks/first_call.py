@@ -18,7 +18,10 @@ Every probe runs in fresh interpreters (``sys.executable``), as a user meets the
 * ``search``: ``GridSearchCV(RTWNearestCentroid(n_centroids=1, dtw_window=None), cv=3)``
   over RTW's ``hidden_size`` and DBA on aeon's GunPoint (its training split), with
   ``n_jobs=1`` and ``n_jobs=2`` (joblib's default process workers), each searched twice in
-  the same process: the second search reuses the workers.
+  the same process: the second search reuses the workers;
+* ``long-search``: the default classifier searched over RTW's ``hidden_size`` x
+  ``learning_rate`` and DBA (5 candidates x 3 folds) on ``--dataset`` from ``--data-dir``
+  (the development archive's Plane by default), ``n_jobs=1`` against ``n_jobs=2``.
 
 Prints one Markdown table per probe with the median over ``--repeat`` processes.
 """
@@ -105,6 +108,21 @@ print(json.dumps(times))
 """
 
 
+LONG_SEARCH = """
+import json, sys, time
+from aeon.datasets import load_classification
+from sklearn.model_selection import GridSearchCV
+from sk_rtw import DBA, RTW, RTWNearestCentroid
+X, y = load_classification(sys.argv[2], split="train", extract_path=sys.argv[3])
+X = X[:, 0, :]
+grid = [{"method": [RTW()], "method__hidden_size": [16, 64],
+         "method__learning_rate": [0.01, 0.003]}, {"method": [DBA()]}]
+t = time.perf_counter()
+GridSearchCV(RTWNearestCentroid(random_state=0), grid, cv=3, n_jobs=int(sys.argv[1])).fit(X, y)
+print(json.dumps(time.perf_counter() - t))
+"""
+
+
 def fresh(code: str, *args: str) -> dict:
     """Run ``code`` in a new interpreter; its last printed line, as JSON."""
     done = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True,
@@ -159,7 +177,17 @@ def probe_search(repeat: int) -> str:
     return "\n".join(lines)
 
 
-PROBES = {"align": probe_align, "split": probe_split, "search": probe_search}
+def probe_long_search(repeat: int, dataset: str, data_dir: str) -> str:
+    header = f"| GridSearchCV on {dataset}, 5 candidates x 3 folds | search (s) |"
+    lines = [header, "| --- | --- |"]
+    for n_jobs in ("1", "2"):
+        runs = [fresh(LONG_SEARCH, n_jobs, dataset, data_dir) for _ in range(repeat)]
+        lines.append(f"| n_jobs={n_jobs} | {median(runs):.2f} |")
+    return "\n".join(lines)
+
+
+PROBES = {"align": probe_align, "split": probe_split, "search": probe_search,
+          "long-search": probe_long_search}  # fmt: skip
 
 
 def main(argv=None) -> None:
@@ -167,10 +195,14 @@ def main(argv=None) -> None:
     parser.add_argument("--probes", nargs="+", choices=list(PROBES), default=list(PROBES))
     parser.add_argument("--repeat", type=positive_int, default=3,
                         help="fresh processes per probe (median reported)")  # fmt: skip
+    parser.add_argument("--data-dir", default="../shared/ucr",
+                        help="archive in aeon's local layout, for long-search")  # fmt: skip
+    parser.add_argument("--dataset", default="Plane", help="dataset of long-search")
     args = parser.parse_args(argv)
     print(f"# First calls\n\nMachine: {machine()}\n")
     for name in args.probes:
-        print(f"## {name}\n\n{PROBES[name](args.repeat)}\n", flush=True)
+        extra = (args.dataset, str(Path(args.data_dir).resolve())) if name == "long-search" else ()
+        print(f"## {name}\n\n{PROBES[name](args.repeat, *extra)}\n", flush=True)
 
 
 if __name__ == "__main__":
