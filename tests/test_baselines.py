@@ -265,3 +265,32 @@ def test_qdtw_align_with_two_series_is_qdtw_and_three_match_brute_force():
     expected = reference_joint_dtw(series, Q, cost=lambda p, q: 1 - abs(float(p @ q)))
     assert triple.cost == pytest.approx(expected, rel=1e-12)
     Q.validate(triple.mean)
+
+
+def test_dba_chooses_the_medoid_of_long_series_on_halved_copies(monkeypatch):
+    """Beyond MEDOID_LENGTH samples the all-pairs DTW runs on copies halved to at most
+    that length; the series it designates starts DBA (here the same as the full search:
+    one series lies between the others)."""
+    import sk_rtw.baselines._dba as dba
+    from sk_rtw.dtw import medoid_index
+    from sk_rtw.utils import check_series_collection
+
+    t = np.linspace(0, 1, 400)
+    X = np.stack([np.sin(2 * np.pi * (t + shift)) for shift in (0.0, 0.04, 0.02, 0.1)])
+    collection = check_series_collection(X, "euclidean")
+    exact = medoid_index(collection)
+    calls = []
+    original = dba.medoid_index
+
+    def spy(candidates, **kwargs):
+        calls.append(candidates.max_length)
+        return original(candidates, **kwargs)
+
+    monkeypatch.setattr(dba, "medoid_index", spy)
+    monkeypatch.setattr(dba, "MEDOID_LENGTH", 100)
+    start = dba._initial_mean(collection, "medoid", None, True)
+    assert calls == [100]  # 400 samples halved twice
+    np.testing.assert_array_equal(start, collection.series(exact))
+    monkeypatch.setattr(dba, "MEDOID_LENGTH", 1000)
+    dba._initial_mean(collection, "medoid", None, True)
+    assert calls[-1] == 400  # short series: the exact search, as before

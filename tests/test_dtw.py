@@ -214,3 +214,27 @@ def test_product_without_distance_segments_uses_general_path():
     )
     D = dtw_pairwise_distance(X, manifold=M)
     assert D[0, 1] == pytest.approx(dtw_distance(X[0], X[1], M), rel=1e-10)
+
+
+@pytest.mark.parametrize("name", ["quaternion", "sphere", "euclidean", "product"])
+def test_paths_with_costs_computed_inside_the_accumulation_equal_the_full_matrix(name):
+    """path_indices computes the point costs row by row inside the band; the full cost
+    matrix gives the same path and cost, bit for bit."""
+    from sk_rtw.datasets import make_warped_signals
+    from sk_rtw.dtw._dtw import point_cost_matrix
+    from sk_rtw.dtw._paths import optimal_path, path_indices
+    from sk_rtw.manifolds import Euclidean, Product, Quaternion
+
+    rng = np.random.default_rng(3)
+    if name == "product":
+        M = Product((Euclidean(3), Quaternion()))
+        x, y = M.random_point(41, random_state=rng), M.random_point(33, random_state=rng)
+    else:
+        data = make_warped_signals(name, 2, 60, random_state=1)
+        M, x, y = data.manifold, data.signals[0], data.signals[1][:47]
+    for window in (-1.0, 0.1, 0.3):
+        for squared in (True, False):
+            path, cost = path_indices(x, y, M, window, squared)
+            full_path, full_cost = optimal_path(point_cost_matrix(x, y, M, squared), window)
+            np.testing.assert_array_equal(path, full_path)
+            assert cost == full_cost

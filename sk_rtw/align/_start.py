@@ -34,7 +34,7 @@ import numpy as np
 import torch
 
 from ..dtw import check_window, medoid_index, path_indices
-from ..dtw._band import halve, multiscale_path
+from ..dtw._band import coarse_collection, multiscale_path
 from ..manifolds import Manifold
 from ..utils import SeriesCollection
 from ._layout import GroupLayout
@@ -131,13 +131,6 @@ def centred_warps(warps: np.ndarray, n_points: int) -> np.ndarray:
     return np.stack([np.interp(times, grid, w) for w in warps])
 
 
-def coarse(series: np.ndarray, manifold: Manifold, length: int) -> np.ndarray:
-    """``series`` halved by geodesic midpoints until it has at most ``length`` samples."""
-    while len(series) > length:
-        series = halve(series, manifold)
-    return series
-
-
 def reference_medoid(
     series: list[np.ndarray],
     manifold: Manifold,
@@ -160,12 +153,7 @@ def reference_medoid(
     pairs = len(index) * (len(index) - 1) / 2
     while length > 16 and pairs * length**2 > MEDOID_CELLS:
         length = (length + 1) // 2
-    small = [coarse(series[i], manifold, length) for i in index]
-    lengths = np.array([len(s) for s in small])
-    data = np.stack(
-        [np.concatenate([s, np.repeat(s[-1:], lengths.max() - len(s), 0)]) for s in small]
-    )
-    collection = SeriesCollection(data=data, lengths=lengths, manifold=manifold)
+    collection = coarse_collection([series[i] for i in index], manifold, length)
     return series[int(index[medoid_index(collection, window=window)])]
 
 

@@ -139,6 +139,26 @@ def halve(series: np.ndarray, manifold: Manifold) -> np.ndarray:
     return mid
 
 
+def coarse(series: np.ndarray, manifold: Manifold, length: int) -> np.ndarray:
+    """``series`` halved by geodesic midpoints until it has at most ``length`` samples."""
+    while len(series) > length:
+        series = halve(series, manifold)
+    return series
+
+
+def coarse_collection(series: list[np.ndarray], manifold: Manifold, length: int):
+    """Every series :func:`coarse` to at most ``length`` samples, as one collection (the
+    shorter ones padded with their last sample, their lengths kept)."""
+    from ..utils import SeriesCollection
+
+    small = [coarse(s, manifold, length) for s in series]
+    lengths = np.array([len(s) for s in small])
+    data = np.stack(
+        [np.concatenate([s, np.repeat(s[-1:], lengths.max() - len(s), 0)]) for s in small]
+    )
+    return SeriesCollection(data=data, lengths=lengths, manifold=manifold)
+
+
 def _band_costs(x, y, lo, hi, manifold, squared) -> np.ndarray:
     width = int((hi - lo).max())
     segments = _kernels.segment_codes(manifold)

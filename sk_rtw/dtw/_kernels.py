@@ -311,6 +311,28 @@ def segment_cost_matrix(x, y, nx, ny, segments, squared, out):
         _cost_row(x, y, i, ny, segments, squared, out[i])
 
 
+@njit(cache=True)
+def accumulated_segment_cost(x, y, segments, squared, window):
+    """The accumulated cost matrix of flattened series ``x`` and ``y``, its point costs
+    computed row by row inside the band (never stored): :func:`accumulated_cost` of
+    :func:`segment_cost_matrix`, value for value, in a third of the memory.
+
+    Returns ``D`` of shape ``(T_x, T_y + 1)``: column 0 is the ``inf`` sentinel, column
+    ``j + 1`` holds column ``j`` (``D[:, 1:]`` is :func:`accumulated_cost`'s result).
+    """
+    nx, ny = x.shape[0], y.shape[0]
+    lo, hi = sakoe_chiba_rows(nx, ny, window)
+    D = np.empty((nx, ny + 1))
+    row = np.empty(ny)
+    prev = _first_prev(ny)
+    for i in range(nx):
+        a, b = lo[i], hi[i]
+        _cost_row(x, y[a:b], i, b - a, segments, squared, row[a:b])
+        _accumulate_row(row, prev, D[i], i, a, b, ny)
+        prev = D[i]
+    return D
+
+
 @njit(cache=True, parallel=True)
 def segment_cost_stack(x, Y, nx, nys, segments, squared):
     """Cost matrices between ``x`` and each series of ``Y``, shape (len(Y), Tx, Ty)."""
