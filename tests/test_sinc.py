@@ -91,7 +91,7 @@ def test_chunks_and_table_budget_do_not_change_the_result(manifold, window, monk
     data, lengths, warps = collection(manifold)
     whole = SincInterpolator(manifold, data, lengths, window)(warps)
     monkeypatch.setattr(_sinc, "CHUNK_ELEMENTS", 50)  # many chunks
-    monkeypatch.setattr(_sinc, "TABLE_BYTES", 0)  # no precomputed table
+    monkeypatch.setattr(_sinc, "table_budget", lambda device: 0)  # no precomputed table
     interpolator = SincInterpolator(manifold, data, lengths, window)
     assert interpolator.table is None
     np.testing.assert_allclose(interpolator(warps).numpy(), whole.numpy(), atol=1e-13)
@@ -141,3 +141,11 @@ def test_nan_warps_give_nan_points_not_an_index_error():
     out = SincInterpolator(Sphere(2), data, lengths)(warps)
     assert torch.isnan(out[0, 3]).all()
     assert torch.isfinite(out[1:]).all()
+
+
+def test_the_table_may_take_an_eighth_of_the_free_memory_on_the_cpu(monkeypatch):
+    monkeypatch.setattr(_sinc, "available_memory", lambda: 64 * 2**30)
+    assert _sinc.table_budget(torch.device("cpu")) == 8 * 2**30
+    monkeypatch.setattr(_sinc, "available_memory", lambda: 2**30)
+    assert _sinc.table_budget(torch.device("cpu")) == _sinc.TABLE_BYTES
+    assert _sinc.table_budget(torch.device("meta")) == _sinc.TABLE_BYTES  # not host memory

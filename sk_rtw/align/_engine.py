@@ -48,7 +48,7 @@ from ._knobs import ENGINE_METHODS, KNOBS
 from ._layout import GroupLayout
 from ._loss import window_weights
 from ._refine import refine_mean
-from ._sinc import TABLE_BYTES, SincInterpolator
+from ._sinc import SincInterpolator, table_budget
 from ._start import dtw_start, path_warp
 from ._training import Trainer, early_stop_note, progress_printer
 from ._warps import NeuralWarps, SineWarps, WarpModel, compose_warps, unit_time
@@ -520,7 +520,8 @@ def estimated_memory(
     steps = config.mean_iterations if config.mean_start == "first" else 1
     per_point = 8 * (point * (6 + (4 * steps if curved else 0)) + 8)
     taps = t_max if config.sinc_window is None else 2 * config.sinc_window + 1
-    table = min(8 * n_series * t_max * taps * point, TABLE_BYTES)
+    table = 8 * n_series * t_max * taps * point
+    table = table if table <= table_budget(torch.device(config.device)) else 0
     times = z if config.warp_knots is None else min(z, config.warp_knots)
     width = config.hidden_size or 0  # TTW's sine warps have no network
     network = 8 * 3 * times * (2 * width + 1 + n_series) + 8 * 4 * z * n_series

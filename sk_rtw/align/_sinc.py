@@ -42,13 +42,25 @@ import math
 import torch
 
 from .._backend import inner
+from .._resources import available_memory
 from ..manifolds import Manifold
 from ._sinc_kernel import window_sums
 
 #: Values gathered at once (per chunk of output indices); bounds the transient memory.
 CHUNK_ELEMENTS = 2**21
-#: Largest table of precomputed window vectors kept for a fit, in bytes.
+#: Largest table of precomputed window vectors kept for a fit, in bytes, unless an eighth
+#: of the free memory is more (see :func:`table_budget`).
 TABLE_BYTES = 512 * 2**20
+
+
+def table_budget(device: torch.device) -> int:
+    """Bytes the table of window vectors may take: :data:`TABLE_BYTES`, or on the CPU an
+    eighth of the free memory when that is more. The table is a cache: without it the
+    window vectors are recomputed in every epoch, which slows the long alignments whose
+    table outgrows a fixed cap (8 quaternion series of 256,000 samples need 1.4 GB)."""
+    if torch.device(device).type != "cpu":
+        return TABLE_BYTES
+    return max(TABLE_BYTES, available_memory() // 8)
 
 
 def barycentric_weights(
@@ -131,14 +143,14 @@ class SincInterpolator:
         Flat manifolds with the windowed sinc store the (clamped) window samples; curved
         manifolds without refinement store their logs at the centre sample. None when
         nothing is gained (flat full sinc: one matrix product) or the table would exceed
-        :data:`TABLE_BYTES` (the vectors are then computed chunk by chunk).
+        :func:`table_budget` (the vectors are then computed chunk by chunk).
         """
         flat = self.manifold.is_flat
         if (flat and self.window is None) or (not flat and self.refinements > 0):
             return None
         n_series, t_max = self.data.shape[:2]
         size = n_series * t_max * self.n_taps * self.point_size * self.data.element_size()
-        if size > TABLE_BYTES:
+        if size > table_budget(self.data.device):
             return None
         with torch.no_grad():
             centres = torch.arange(t_max, device=self.data.device).expand(n_series, -1)
