@@ -151,6 +151,8 @@ def cell(record: dict | None) -> str:
         return f"over {record['seconds_over'] / 60:.0f} min"
     if status == "missing":
         return "not installed"
+    if status == "skipped":
+        return "not started"
     return "error"
 
 
@@ -225,7 +227,7 @@ def main(argv=None) -> None:
             if file.exists():
                 results[key] = json.loads(file.read_text())
             elif stopped is not None:
-                results[key] = stopped
+                results[key] = {"status": "skipped", "after": stopped["status"]}
                 continue
             else:
                 results[key] = run_one(method, T, args)
