@@ -12,7 +12,7 @@ from ..align._knobs import owners
 from ..methods._registry import METHODS, method_parameter
 from ..utils._common_params import DTW_WINDOW as BAND
 from ..utils._common_params import MANIFOLD, N_JOBS, RANDOM_STATE, VERBOSE
-from ..utils._params import Interval, Options, Parameter, doc_indent, indent
+from ..utils._params import Interval, Options, Parameter, doc_indent, indent, wrap
 
 METHOD = method_parameter(
     'Averaging method: "rtw", "ttw", "ntw", "dba" (DTW barycenter averaging with Fréchet '
@@ -140,14 +140,8 @@ def settings_notes(method: str, preset: str, chooses: bool = False) -> str:
             'and "alignment" the band and the centroids per class are chosen from the '
             'training data (``selection_``); under "paper" one mean per class and no band.'
         )
-    wrapped = [line for paragraph in text for line in (*_wrap_text(paragraph), "")]
+    wrapped = [line for paragraph in text for line in (*wrap(paragraph), "")]
     return "\n".join([*wrapped, settings_table(method, preset)])
-
-
-def _wrap_text(text: str) -> list[str]:
-    import textwrap
-
-    return textwrap.wrap(text, 84)
 
 
 def document_settings(cls):

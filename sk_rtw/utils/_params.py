@@ -298,11 +298,12 @@ class Declaration:
             text = f'"{default}"' if isinstance(default, str) else repr(default)
             lines.append(f"{p.name} : {p.type_doc()}, default={text}")
             body = p.doc + (f" {notes[p.name]}" if p.name in notes else "")
-            lines.extend("    " + line for line in _wrap(body))
+            lines.extend("    " + line for line in wrap(body))
         return "\n".join(lines)
 
 
-def _wrap(text: str, width: int = 84) -> list[str]:
+def wrap(text: str, width: int = 84) -> list[str]:
+    """``text`` in lines of at most ``width`` characters, paragraph by paragraph."""
     import textwrap
 
     out: list[str] = []
