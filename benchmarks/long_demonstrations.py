@@ -11,11 +11,13 @@ one smooth random rotation trajectory under eight random monotone time warps), f
 from 1,000 (one second at 1 kHz) to 256,000 (four minutes). Every (method, T) runs alone
 in a fresh process, one thread, until it is done, runs past ``--time-limit`` (30 min) or
 would not fit in the memory available (estimated before the start from its T x T
-matrices); a method that ran out of time or memory is not started at longer T.
+matrices, for aeon's and tslearn's); a method that ran out of time or memory is not
+started at longer T.
 
 * ``rtw``: :func:`sk_rtw.align` with its defaults (the "alignment" preset);
 * ``sk_rtw-dba``: :func:`sk_rtw.baselines.dba_average` on the quaternion manifold (exact
-  DTW with geodesic costs, Fréchet means; medoid start, at most 10 iterations);
+  DTW with geodesic costs, Fréchet means; medoid start, at most 10 iterations; each DTW
+  skips the cells that cannot beat a known path, exact all the same);
 * ``aeon-dba``: aeon's ``elastic_barycenter_average(distance="dtw")`` (Petitjean's DBA,
   its defaults: mean start, at most 30 iterations) on the quaternions as 4 channels;
 * ``tslearn-dba``: tslearn's ``dtw_barycenter_averaging`` (its defaults, at most 30
@@ -45,10 +47,11 @@ from benchmarks._shared import check_writable, machine, positive_int
 
 METHODS = ("rtw", "sk_rtw-dba", "aeon-dba", "tslearn-dba")
 LENGTHS = (1000, 4000, 16000, 64000, 256000)
-#: Bytes per T x T cell each DBA keeps at once: sk_rtw the accumulated cost (its point
-#: costs are computed inside the accumulation), aeon the cost matrix, tslearn about 125
-#: (measured: 2.0 GB above the imports at 4,000 samples; killed at 16,000 here).
-MATRIX_BYTES = {"sk_rtw-dba": 8, "aeon-dba": 8, "tslearn-dba": 125}
+#: Bytes per T x T cell the DBAs that fill whole DTW matrices keep at once: aeon the cost
+#: matrix, tslearn about 125 (measured: 2.0 GB above the imports at 4,000 samples; killed
+#: at 16,000 here). sk_rtw's stores only the cells a path cheaper than the previous
+#: iteration's can pass (its memory is not known before the run).
+MATRIX_BYTES = {"aeon-dba": 8, "tslearn-dba": 125}
 
 RUN = r"""
 import json, resource, sys, time, os

@@ -238,3 +238,78 @@ def test_paths_with_costs_computed_inside_the_accumulation_equal_the_full_matrix
             full_path, full_cost = optimal_path(point_cost_matrix(x, y, M, squared), window)
             np.testing.assert_array_equal(path, full_path)
             assert cost == full_cost
+
+
+def dense(rows, nx, ny):
+    """The stored rows of accumulated_segment_cost as a matrix (``inf`` where not stored)."""
+    values, offsets, starts = rows
+    D = np.full((nx, ny), np.inf)
+    for i in range(nx):
+        row = values[offsets[i] : offsets[i + 1]]
+        D[i, starts[i] : starts[i] + len(row)] = row
+    return D
+
+
+@pytest.mark.parametrize("name", ["quaternion", "sphere", "euclidean"])
+def test_a_guide_path_skips_cells_without_changing_the_path_or_cost(name):
+    """PrunedDTW: cells whose accumulated cost exceeds a known path's cost are skipped;
+    the cells under it are bit for bit the full recursion's, the others no lower, so the
+    optimal path and cost are the same whatever the guide (a poor one, one outside the
+    band: recomputed), and a close guide skips most cells and stores only what it
+    computed."""
+    from sk_rtw.datasets import make_warped_signals
+    from sk_rtw.dtw import _kernels
+    from sk_rtw.dtw._dtw import _flat, point_cost_matrix
+    from sk_rtw.dtw._paths import path_indices
+
+    data = make_warped_signals(name, 2, 300, random_state=4)
+    M, x, y = data.manifold, data.signals[0], data.signals[1][:260]
+    segments = _kernels.segment_codes(M)
+    fx, fy = _flat(x), _flat(y)
+    staircase = np.stack([np.r_[np.arange(300), np.full(259, 299)],
+                          np.r_[np.zeros(300, int), np.arange(1, 260)]], 1)  # fmt: skip
+    diagonal = np.stack([np.arange(300), np.arange(300) * 259 // 299], 1)
+    for window in (-1.0, 0.2):
+        for squared in (True, False):
+            full = _kernels.accumulated_cost(point_cost_matrix(x, y, M, squared), window)
+            stored = _kernels.accumulated_segment_cost(fx, fy, segments, squared, window,
+                                                       np.inf)  # fmt: skip
+            np.testing.assert_array_equal(dense(stored, 300, 260), full)
+            best = np.asarray(_kernels.backtrack(full), dtype=np.int64).reshape(-1, 2)
+            for guide in (best, diagonal, staircase):
+                path, cost = path_indices(x, y, M, window, squared, guide)
+                np.testing.assert_array_equal(path, best)
+                assert cost == full[-1, -1]
+                bound = _kernels.path_cost(fx, fy, guide, segments, squared)
+                rows = _kernels.accumulated_segment_cost(fx, fy, segments, squared, window,
+                                                         bound)  # fmt: skip
+                pruned = dense(rows, 300, 260)
+                under = full <= bound
+                np.testing.assert_array_equal(pruned[under], full[under])
+                assert np.all(pruned[~under] >= full[~under])
+            bound = _kernels.path_cost(fx, fy, best, segments, squared)
+            assert bound == full[-1, -1]  # the recursion's value of its own path
+            rows = _kernels.accumulated_segment_cost(fx, fy, segments, squared, window, bound)
+            if window < 0:  # without a band: 28-60 % of the cells here (0.4 % at T = 4,000)
+                assert len(rows[0]) < 0.7 * np.isfinite(full).sum()
+
+
+def test_pairwise_distances_with_bounds_equal_those_without(rng):
+    """Bounds from any path (close, poor, or too low to be a path's cost) give the same
+    distances: a bound under the distance is detected and the pair computed again."""
+    from sk_rtw.dtw import _kernels
+    from sk_rtw.dtw._dtw import _pairwise
+    from sk_rtw.utils import check_series_collection
+
+    Q = Quaternion()
+    X = np.stack([random_walk(Q, 40, seed) for seed in range(5)])
+    collection = check_series_collection(X, Q)
+    for window in (None, 0.3):
+        plain = dtw_pairwise_distance(X, manifold=Q, squared=True, window=window)
+        for scale in (1.0, 1.5, 0.5, 0.0):
+            bounds = plain * scale + (rng.random(plain.shape) * 1e-3 if scale else 0.0)
+            w = -1.0 if window is None else window
+            got = _pairwise(collection, collection, w, True, True, False, bounds)
+            np.testing.assert_array_equal(got, plain)
+    low = plain[0, 1] * 0.5
+    assert _kernels.pruned_distance(X[0], X[1], _kernels.segment_codes(Q), True, -1.0, low) > low

@@ -21,9 +21,9 @@ def test_runs_records_skips_what_would_not_fit_and_resumes(tmp_path, monkeypatch
     assert "| 40 |" in table and (tmp_path / "plot.png").exists()
     # a DBA whose T x T matrix exceeds the memory is not started, nor at longer T
     monkeypatch.setattr(long, "available_bytes", lambda: 1000)
-    long.main(["--lengths", "50", "60", "--methods", "sk_rtw-dba", "--out", str(out)])
-    assert json.loads((out / "sk_rtw-dba-50-seed0.json").read_text())["status"] == "memory"
-    assert not (out / "sk_rtw-dba-60-seed0.json").exists()
+    long.main(["--lengths", "50", "60", "--methods", "aeon-dba", "--out", str(out)])
+    assert json.loads((out / "aeon-dba-50-seed0.json").read_text())["status"] == "memory"
+    assert not (out / "aeon-dba-60-seed0.json").exists()
     assert "does not fit" in capsys.readouterr().out
     # finished runs are read back, not run again
     monkeypatch.setattr(long, "run_one", lambda *a: (_ for _ in ()).throw(AssertionError))

@@ -95,8 +95,13 @@ def dba_average(
     best: tuple[float, np.ndarray, tuple[np.ndarray, ...]] | None = None
     previous = np.inf
     iteration = 0
+    N = len(series)
+    guides: tuple[np.ndarray | None, ...] = (None,) * N
     for iteration in range(max_iter + 1):
-        paths, costs = zip(*(path_indices(mean, s, M, w, squared) for s in series), strict=True)
+        # the previous paths are paths to the new mean too: their costs bound the search
+        found = [path_indices(mean, series[n], M, w, squared, guides[n]) for n in range(N)]
+        paths, costs = zip(*found, strict=True)
+        guides = paths
         cost = float(sum(costs))
         if best is None or cost < best[0]:
             best = (cost, mean, paths)

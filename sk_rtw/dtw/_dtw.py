@@ -275,17 +275,29 @@ def dtw_pairwise_distance(
 
 
 def _pairwise(
-    cx: SeriesCollection, cy: SeriesCollection, window, squared, symmetric, per_step
+    cx: SeriesCollection,
+    cy: SeriesCollection,
+    window,
+    squared,
+    symmetric,
+    per_step,
+    bounds: np.ndarray | None = None,
 ) -> np.ndarray:
+    """The distances of :func:`dtw_pairwise_distance`; ``bounds[i, j]``, the cost of some
+    path between the pair, lets the kernels skip the cells that cannot beat it (same
+    result)."""
     manifold = cx.manifold
     segments = _kernels.segment_codes(manifold)
     if segments is not None:
         flat_x = np.ascontiguousarray(cx.data.reshape(cx.n_series, cx.max_length, -1))
         flat_y = np.ascontiguousarray(cy.data.reshape(cy.n_series, cy.max_length, -1))
         if not per_step:
+            if bounds is None:
+                bounds = np.full((cx.n_series, cy.n_series), np.inf)
             return _kernels.pairwise_segments(
-                flat_x, cx.lengths, flat_y, cy.lengths, segments, squared, window, symmetric
-            )
+                flat_x, cx.lengths, flat_y, cy.lengths, segments, squared, window, symmetric,
+                bounds,
+            )  # fmt: skip
     # Cost matrices for a block of pairs at a time (numba for the known point distances,
     # the vectorised geometry otherwise), then the parallel recursion over the block.
     n, m = cx.n_series, cy.n_series

@@ -169,7 +169,14 @@ def _step_back(D, i, j):
         return i, j - 1
     if j == 0:
         return i - 1, j
-    diag, up, left = D[i - 1, j - 1], D[i - 1, j], D[i, j - 1]
+    return choose_step(i, j, D[i - 1, j - 1], D[i - 1, j], D[i, j - 1])
+
+
+@njit(cache=True, inline="always")
+def choose_step(i, j, diag, up, left):
+    """The cell before ``(i, j)``, both positive, from its three neighbours' accumulated
+    costs: the cheapest, ties broken diagonal, then up, then left (every backtracking of
+    the package breaks them so)."""
     if diag <= up and diag <= left:
         return i - 1, j - 1
     if up <= left:
@@ -312,25 +319,165 @@ def segment_cost_matrix(x, y, nx, ny, segments, squared, out):
 
 
 @njit(cache=True)
-def accumulated_segment_cost(x, y, segments, squared, window):
-    """The accumulated cost matrix of flattened series ``x`` and ``y``, its point costs
-    computed row by row inside the band (never stored): :func:`accumulated_cost` of
-    :func:`segment_cost_matrix`, value for value, in a third of the memory.
+def path_cost(x, y, path, segments, squared):
+    """The cost of a warping path ``(P, 2)`` between flattened series, summed along it
+    in order: the value the DTW recursion gives that path, bit for bit (the same point
+    costs, added in the same order)."""
+    total = 0.0
+    cost = np.empty(1)
+    for k in range(path.shape[0]):
+        j = path[k, 1]
+        _cost_row(x, y[j : j + 1], path[k, 0], 1, segments, squared, cost)
+        total = cost[0] + total
+    return total
 
-    Returns ``D`` of shape ``(T_x, T_y + 1)``: column 0 is the ``inf`` sentinel, column
-    ``j + 1`` holds column ``j`` (``D[:, 1:]`` is :func:`accumulated_cost`'s result).
+
+#: Point costs of a pruned row are computed this many columns at a time (vectorised as in
+#: :func:`_cost_row`); a row that stops early wastes at most this many.
+PRUNE_CHUNK = 32
+
+
+@njit(cache=True, inline="always")
+def _pruned_row(x, y, i, prev, cur, costs, lo, hi, reach, bound, segments, squared):
+    """Row ``i`` of the accumulated cost into ``cur`` (padded as in :func:`_accumulate_row`)
+    from column ``lo`` on, skipping what cannot beat ``bound`` (PrunedDTW: Silva and
+    Batista, 2016). ``costs`` is a scratch row of at least ``hi`` entries.
+
+    A cell is "kept" when its accumulated cost is at most ``bound``. ``reach`` is the last
+    kept column of the row above plus one: past it the cells above and above-left exceed
+    the bound, so the first cell there that exceeds it ends the row (every cell to its
+    right would too). Returns the first and last kept columns (-1 if none) and the last
+    column written.
     """
+    if bound == _INF:  # nothing to skip: the plain recursion
+        _cost_row(x, y[lo:hi], i, hi - lo, segments, squared, costs[lo:hi])
+        _band_row(costs, prev, cur, lo, hi)
+        return lo, hi - 1, hi - 1
+    left = _INF
+    first, last = -1, -1
+    for chunk in range(lo, hi, PRUNE_CHUNK):
+        stop = min(hi, chunk + PRUNE_CHUNK)
+        _cost_row(x, y[chunk:stop], i, stop - chunk, segments, squared, costs[chunk:stop])
+        for j in range(chunk, stop):
+            best = prev[j]
+            if prev[j + 1] < best:
+                best = prev[j + 1]
+            if left < best:
+                best = left
+            left = costs[j] + best
+            cur[j + 1] = left
+            if left <= bound:
+                if first < 0:
+                    first = j
+                last = j
+            elif j >= reach:
+                return first, last, j
+    return first, last, hi - 1
+
+
+@njit(cache=True)
+def accumulated_segment_cost(x, y, segments, squared, window, bound):
+    """The accumulated cost of flattened series ``x`` and ``y`` where a path of cost at
+    most ``bound`` can pass, stored row by row (:func:`_pruned_row`; ``inf``: every cell
+    of the band).
+
+    Every cell whose accumulated cost is at most ``bound`` holds the value of
+    :func:`accumulated_cost` of :func:`segment_cost_matrix`, bit for bit; every other
+    cell holds that value or more (``inf`` where skipped). So when the last cell is at
+    most ``bound`` (the cost of any path inside the band bounds it), it and the optimal
+    path backtracked from it are the exact ones; otherwise the bound was too low and the
+    caller recomputes with ``inf``. Row ``i`` starts at the first kept column of row
+    ``i - 1``: the cells computed are a band around the paths cheaper than the bound, and
+    only they are stored (memory in proportion to them, not to ``T_x T_y``).
+
+    Returns ``(values, offsets, starts)``: row ``i`` holds columns ``starts[i]`` onwards
+    in ``values[offsets[i]:offsets[i + 1]]`` (:func:`ragged_value` reads a cell).
+    """
+    return _pruned_rows(x, y, segments, squared, window, bound, True)[:3]
+
+
+@njit(cache=True)
+def pruned_distance(x, y, segments, squared, window, bound):
+    """The DTW distance of flattened series ``x`` and ``y`` in two rows of memory, the
+    cells that cannot beat ``bound`` skipped as in :func:`accumulated_segment_cost`:
+    exact when at most ``bound``, otherwise some value above it (``inf`` if the bound
+    was too low)."""
+    return _pruned_rows(x, y, segments, squared, window, bound, False)[3]
+
+
+@njit(cache=True)
+def _pruned_rows(x, y, segments, squared, window, bound, store):
+    """Rows of the accumulated cost in two buffers, each kept in ``values`` if ``store``:
+    ``(values, offsets, starts, last cell)`` (see :func:`accumulated_segment_cost`)."""
     nx, ny = x.shape[0], y.shape[0]
     lo, hi = sakoe_chiba_rows(nx, ny, window)
-    D = np.empty((nx, ny + 1))
-    row = np.empty(ny)
-    prev = _first_prev(ny)
+    prev, cur = _two_rows(ny)
+    costs = np.empty(ny)
+    values = np.empty(min(nx * ny, max(1 << 16, 64 * (nx + ny))) if store else 0)
+    offsets = np.zeros(nx + 1, dtype=np.int64)
+    starts = np.zeros(nx, dtype=np.int64)
+    start, reach = 0, 0  # row -1 keeps only its sentinel (column -1)
+    prev_end, cur_end = 0, 0  # the last padded entry each buffer holds a value in
     for i in range(nx):
-        a, b = lo[i], hi[i]
-        _cost_row(x, y[a:b], i, b - a, segments, squared, row[a:b])
-        _accumulate_row(row, prev, D[i], i, a, b, ny)
-        prev = D[i]
-    return D
+        a = max(lo[i], start)
+        cur[a] = _INF  # column a - 1, which the next row reads and this one does not write
+        first, last, written = _pruned_row(
+            x, y, i, prev, cur, costs, a, hi[i], reach, bound, segments, squared
+        )
+        for k in range(written + 2, cur_end + 1):  # what two rows ago left further right
+            cur[k] = _INF
+        cur_end = max(written + 1, a)
+        if store:
+            n = written - a + 1
+            if offsets[i] + n > values.shape[0]:  # grow by doubling
+                grown = np.empty(max(2 * values.shape[0], offsets[i] + n))
+                grown[: offsets[i]] = values[: offsets[i]]
+                values = grown
+            values[offsets[i] : offsets[i] + n] = cur[a + 1 : written + 2]
+            starts[i], offsets[i + 1] = a, offsets[i] + n
+        if first < 0:  # no cell of this row is kept: nor is the last cell
+            if store:
+                offsets[i + 2 :] = offsets[i + 1]
+            return values[: offsets[nx]], offsets, starts, _INF
+        start, reach = first, last + 1
+        prev, cur = cur, prev
+        prev_end, cur_end = cur_end, prev_end
+    return values[: offsets[nx]], offsets, starts, prev[ny]
+
+
+@njit(cache=True, inline="always")
+def ragged_value(values, offsets, starts, i, j):
+    """Cell ``(i, j)`` of :func:`accumulated_segment_cost`'s rows (``inf`` if not stored)."""
+    k = j - starts[i]
+    if k < 0 or k >= offsets[i + 1] - offsets[i]:
+        return _INF
+    return values[offsets[i] + k]
+
+
+@njit(cache=True)
+def ragged_backtrack(values, offsets, starts, ny):
+    """The optimal path ``(P, 2)`` through :func:`accumulated_segment_cost`'s rows, ties
+    broken as :func:`backtrack` breaks them."""
+    nx = starts.shape[0]
+    i, j = nx - 1, ny - 1
+    path = np.empty((nx + ny - 1, 2), dtype=np.int64)
+    n = 0
+    path[n, 0], path[n, 1] = i, j
+    while i > 0 or j > 0:
+        if i == 0:
+            j -= 1
+        elif j == 0:
+            i -= 1
+        else:
+            i, j = choose_step(
+                i, j,
+                ragged_value(values, offsets, starts, i - 1, j - 1),
+                ragged_value(values, offsets, starts, i - 1, j),
+                ragged_value(values, offsets, starts, i, j - 1),
+            )  # fmt: skip
+        n += 1
+        path[n, 0], path[n, 1] = i, j
+    return path[: n + 1][::-1].copy()
 
 
 @njit(cache=True, parallel=True)
@@ -343,31 +490,27 @@ def segment_cost_stack(x, Y, nx, nys, segments, squared):
 
 
 @njit(cache=True, parallel=True)
-def pairwise_segments(X, lx, Y, ly, segments, squared, window, symmetric):
+def pairwise_segments(X, lx, Y, ly, segments, squared, window, symmetric, bounds):
     """DTW between every series of ``X`` and of ``Y``, the cost rows computed in numba.
 
     Each cost row is computed just before the recursion consumes it, so the cost matrix
     never leaves the cache, and only within the band: a narrow band costs its width.
-    Returns the distances, shape ``(len(X), len(Y))``.
+    ``bounds[i, j]`` is the cost of some path between the pair (``inf``: none known); the
+    cells that cannot beat it are skipped (:func:`pruned_distance`; the pair is computed
+    again without it if it was too low). Returns the distances, shape ``(len(X), len(Y))``.
     """
     n, m = X.shape[0], Y.shape[0]
     values = np.zeros((n, m))
-    ty = Y.shape[1]
     for k in prange(n * m):
         i = k // m
         j = k - i * m
         if symmetric and j <= i:
             continue
-        nx, ny = lx[i], ly[j]
-        lo, hi = sakoe_chiba_rows(nx, ny, window)
-        row = np.empty(ty)
-        prev, cur = _two_rows(ny)
-        for r in range(nx):
-            a, b = lo[r], hi[r]  # the recursion reads no cost outside the band
-            _cost_row(X[i], Y[j, a:b], r, b - a, segments, squared, row[a:b])
-            _band_row(row, prev, cur, a, b)
-            prev, cur = cur, prev
-        values[i, j] = prev[ny]
+        x, y = X[i, : lx[i]], Y[j, : ly[j]]
+        value = pruned_distance(x, y, segments, squared, window, bounds[i, j])
+        if not value <= bounds[i, j]:
+            value = pruned_distance(x, y, segments, squared, window, _INF)
+        values[i, j] = value
     if symmetric:
         for i in range(n):
             for j in range(i):

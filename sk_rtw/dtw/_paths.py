@@ -8,10 +8,17 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._numba import numba_threads
 from ..manifolds import Manifold
 from ..utils import SeriesCollection
 from . import _kernels
-from ._dtw import _flat, dtw_pairwise_distance, point_cost_matrix
+from ._band import EXACT_CELLS, multiscale_path
+from ._dtw import _flat, _pairwise, check_window, point_cost_matrix
+
+#: Relative margin on a guide path's cost: the recursion adds the same point costs in
+#: the same order, so no margin is needed in exact arithmetic; this one covers a last-bit
+#: difference between two compiled copies of the point cost.
+GUIDE_SLACK = 1e-9
 
 
 def optimal_path(cost: np.ndarray, window: float = -1.0) -> tuple[np.ndarray, float]:
@@ -44,6 +51,7 @@ def path_indices(
     manifold: Manifold,
     window: float = -1.0,
     squared: bool = False,
+    guide: np.ndarray | None = None,
 ) -> tuple[np.ndarray, float]:
     """Optimal DTW path ``(P, 2)`` between two validated series, and its cost.
 
@@ -56,6 +64,12 @@ def path_indices(
         Sakoe–Chiba radius (fraction of the shorter series); negative: no band.
     squared : bool, default=False
         Squared geodesic point costs.
+    guide : ndarray of shape (P', 2), int, optional
+        Any warping path between ``x`` and ``y`` inside the band, close to the optimal
+        one (an earlier iteration's path): its cost bounds the search, and the cells that
+        cannot beat it are skipped. The result does not depend on it (a poor guide only
+        saves less). Default: for pairs of more than ``2**20`` cells without a band, the
+        coarse-to-fine path (:func:`~sk_rtw.dtw.multiscale_path`); otherwise none.
 
     Returns
     -------
@@ -65,12 +79,23 @@ def path_indices(
     segments = _kernels.segment_codes(manifold)
     if segments is None:
         return optimal_path(point_cost_matrix(x, y, manifold, squared), window)
-    # the point costs computed inside the accumulation: the T_x x T_y cost matrix is
-    # never stored (a third of the memory, and less memory traffic, on long series)
-    D = _kernels.accumulated_segment_cost(_flat(x), _flat(y), segments, squared, window)[:, 1:]
-    if not np.isfinite(D[-1, -1]):  # the full cost matrix says why
+    # the point costs are computed inside the accumulation (the T_x x T_y cost matrix is
+    # never stored) and only where a path could still beat the guide's cost
+    fx, fy = _flat(x), _flat(y)
+    if guide is None and (window < 0.0 or window >= 1.0) and len(x) * len(y) > EXACT_CELLS:
+        guide = multiscale_path(x, y, manifold, squared)[0]  # close, and cheap next to this
+    bound = np.inf
+    if guide is not None:
+        bound = _kernels.path_cost(fx, fy, np.asarray(guide, dtype=np.int64), segments, squared)
+        bound *= 1.0 + GUIDE_SLACK
+    rows = _kernels.accumulated_segment_cost(fx, fy, segments, squared, window, bound)
+    cost = _kernels.ragged_value(*rows, len(x) - 1, len(y) - 1)
+    if not cost <= bound:  # the guide left the band, or a cost is not finite
+        rows = _kernels.accumulated_segment_cost(fx, fy, segments, squared, window, np.inf)
+        cost = _kernels.ragged_value(*rows, len(x) - 1, len(y) - 1)
+    if not np.isfinite(cost):  # the full cost matrix says why
         return optimal_path(point_cost_matrix(x, y, manifold, squared), window)
-    return np.asarray(_kernels.backtrack(D), dtype=np.int64).reshape(-1, 2), float(D[-1, -1])
+    return _kernels.ragged_backtrack(*rows, len(y)), float(cost)
 
 
 def medoid_index(
@@ -97,5 +122,29 @@ def medoid_index(
         Index into ``collection``.
     """
     index = np.arange(collection.n_series) if candidates is None else np.asarray(candidates)
-    D = dtw_pairwise_distance(collection.subset(index), window=window, squared=squared)
+    subset = collection.subset(index)
+    w = check_window(window)
+    bounds = _guide_bounds(subset, w, squared)
+    with numba_threads(None):  # as dtw_pairwise_distance's default: one thread
+        D = _pairwise(subset, subset, w, squared, True, False, bounds)
     return int(index[np.argmin(D.sum(1))])
+
+
+def _guide_bounds(collection: SeriesCollection, window: float, squared: bool):
+    """The cost of the coarse-to-fine path of every pair of long series (more than
+    ``2**20`` cells) without a band, ``inf`` for the others: bounds that let the exact
+    pairwise DTW skip most cells (:func:`path_indices`' default guide, pair by pair)."""
+    n = collection.n_series
+    bounds = np.full((n, n), np.inf)
+    segments = _kernels.segment_codes(collection.manifold)
+    if segments is None or 0.0 <= window < 1.0:
+        return bounds
+    series = [collection.series(i) for i in range(n)]
+    for i in range(n):
+        for j in range(i + 1, n):
+            x, y = series[i], series[j]
+            if len(x) * len(y) > EXACT_CELLS:
+                path = multiscale_path(x, y, collection.manifold, squared)[0]
+                cost = _kernels.path_cost(_flat(x), _flat(y), path, segments, squared)
+                bounds[i, j] = cost * (1.0 + GUIDE_SLACK)
+    return bounds
