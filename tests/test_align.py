@@ -812,3 +812,37 @@ def test_the_engines_adam_is_torchs_fused_adam_bit_for_bit():
         for a, b in zip(ours, theirs, strict=True):
             assert torch.equal(a, b), step
     assert not torch.equal(ours[0], start[0])  # it moved
+
+
+@pytest.mark.parametrize("manifold", ["euclidean", "quaternion", "spd"])
+@pytest.mark.parametrize("window", [None, 0.2])
+def test_the_dtw_starts_path_warps_are_those_of_each_pairs_path(manifold, window):
+    """The DTW start reads the warps of the exact pairs off one compiled pass; they equal,
+    value for value, path_warp of each pair's path (multiscale_path without a band,
+    path_indices in one), with groups of unequal reference lengths, and the smoothing
+    equals np.pad's odd reflection."""
+    from sk_rtw.align._start import _path_warps, _smooth_monotone, path_warp
+    from sk_rtw.dtw import multiscale_path, path_indices
+
+    data = make_warped_signals(manifold, 5, 50, 3, strength=0.9)
+    M, series = data.manifold, [s[: 50 - 3 * n] for n, s in enumerate(data.signals)]
+    references = [data.signals[0][:44], data.signals[1][::2]]
+    codes = np.array([0, 1, 0, 1, 1])
+    got = _path_warps(references, series, codes, M, window, None)
+    for n, s in enumerate(series):
+        reference = references[codes[n]]
+        if window is None:
+            path = multiscale_path(reference, s, M, squared=True)[0]
+        else:
+            path = path_indices(reference, s, M, window, squared=True)[0]
+        np.testing.assert_array_equal(got[n], path_warp(path, len(reference), len(s)))
+    warp = np.sort(np.random.default_rng(0).random(9))
+    for sigma in (0.7, 2.0, 5.0):  # radius 3, 6 and capped at len - 1
+        radius = min(int(np.ceil(3 * sigma)), 8)
+        kernel = np.exp(-0.5 * (np.arange(-radius, radius + 1) / sigma) ** 2)
+        smooth = np.convolve(np.pad(warp, radius, mode="reflect", reflect_type="odd"),
+                             kernel / kernel.sum(), mode="valid")  # fmt: skip
+        smooth = np.maximum.accumulate(
+            np.clip((smooth - smooth[0]) / (smooth[-1] - smooth[0]), 0.0, 1.0)
+        )
+        np.testing.assert_array_equal(_smooth_monotone(warp, sigma), smooth)

@@ -34,7 +34,8 @@ import numpy as np
 import torch
 
 from ..dtw import check_window, medoid_index, path_indices
-from ..dtw._band import coarse_collection, multiscale_path
+from ..dtw._band import coarse_collection, multiscale_path, solved_exactly
+from ..dtw._kernels import matched_positions, segment_codes
 from ..manifolds import Manifold
 from ..utils import SeriesCollection
 from ._layout import GroupLayout
@@ -67,10 +68,17 @@ def path_warp(
     """
     sums = np.bincount(path[:, 0], weights=path[:, 1], minlength=n_reference)
     counts = np.bincount(path[:, 0], minlength=n_reference)
-    warp = np.maximum.accumulate(sums / counts / max(length - 1, 1))
+    return position_warp(sums / counts, length, smoothing)
+
+
+def position_warp(
+    positions: np.ndarray, length: int, smoothing: float | None = None
+) -> np.ndarray:
+    """:func:`path_warp` from the mean matched index of every reference sample."""
+    warp = np.maximum.accumulate(positions / max(length - 1, 1))
     warp[0], warp[-1] = 0.0, 1.0
     smoothing = SMOOTHING if smoothing is None else smoothing
-    if smoothing > 0 and n_reference > 2:
+    if smoothing > 0 and len(warp) > 2:
         warp = _smooth_monotone(warp, smoothing)
     return warp
 
@@ -89,8 +97,11 @@ def _smooth_monotone(warp: np.ndarray, sigma: float) -> np.ndarray:
     radius = min(int(np.ceil(3 * sigma)), len(warp) - 1)
     offsets = np.arange(-radius, radius + 1)
     kernel = np.exp(-0.5 * (offsets / sigma) ** 2)
-    # odd reflection about the ends keeps the end values and the monotonicity
-    padded = np.pad(warp, radius, mode="reflect", reflect_type="odd")
+    # odd reflection about the ends keeps the end values and the monotonicity (np.pad's
+    # "reflect" with reflect_type="odd", value for value, without its overhead)
+    padded = np.concatenate(
+        (2 * warp[0] - warp[radius:0:-1], warp, 2 * warp[-1] - warp[-2 : -radius - 2 : -1])
+    )
     smooth = np.convolve(padded, kernel / kernel.sum(), mode="valid")
     smooth = (smooth - smooth[0]) / (smooth[-1] - smooth[0])
     return np.maximum.accumulate(np.clip(smooth, 0.0, 1.0))
@@ -205,7 +216,6 @@ def dtw_start(
     if axis not in START_AXES:
         raise ValueError(f"axis must be one of {START_AXES}, got {axis!r}")
     on_axis = centred_warps if axis == "average" else reference_warps
-    band = check_window(window)
     manifold = collection.manifold
     series = [collection.series(i) for i in range(collection.n_series)]
     members = [layout.members(g) for g in range(layout.n_groups)]
@@ -216,16 +226,10 @@ def dtw_start(
     # later references: the group mean at the output length
     ref_points = [n_points for _ in members]
     codes = layout.codes.cpu().numpy()
-    along = [np.empty(0)] * len(series)
+    along: list[np.ndarray] = []
     for round_ in range(rounds):
         previous = list(along)
-        for i, s in enumerate(series):
-            reference = references[codes[i]]
-            if window is None:
-                path, _ = multiscale_path(reference, s, manifold, squared=True)
-            else:
-                path, _ = path_indices(reference, s, manifold, band, squared=True)
-            along[i] = path_warp(path, len(reference), len(s), smoothing)
+        along = _path_warps(references, series, codes, manifold, window, smoothing)
         if round_ == rounds - 1 or (
             round_ > 1 and all(np.array_equal(a, b) for a, b in zip(along, previous, strict=True))
         ):  # a fixed point: the next reference would be this one again
@@ -245,3 +249,54 @@ def dtw_start(
         else:
             warps[idx] = on_axis(np.stack([along[i] for i in idx]), n_points)
     return warps
+
+
+def _path_warps(
+    references: list[np.ndarray],
+    series: list[np.ndarray],
+    codes: np.ndarray,
+    manifold: Manifold,
+    window: float | None,
+    smoothing: float | None,
+) -> list[np.ndarray]:
+    """:func:`path_warp` of every series' DTW path (squared costs) to the reference of
+    its group: in a band if ``window`` is given, else coarse to fine for long pairs.
+
+    The pairs whose path is exact (a band, or short enough for
+    :func:`~sk_rtw.dtw._band.multiscale_path` to solve them exactly) go through one
+    compiled pass (:func:`~sk_rtw.dtw._kernels.matched_positions`: the same paths, no
+    Python per pair); the others one by one.
+    """
+    band = check_window(window)
+    segments = segment_codes(manifold)
+    exact = [
+        n for n, s in enumerate(series)
+        if segments is not None
+        and ((0.0 <= band < 1.0) or solved_exactly(len(references[codes[n]]), len(s)))
+    ]  # fmt: skip
+    warps: list[np.ndarray] = [np.empty(0)] * len(series)
+    if exact:
+        positions = matched_positions(
+            _stack(references), np.array([len(r) for r in references]),
+            _stack([series[n] for n in exact]), np.array([len(series[n]) for n in exact]),
+            codes[exact], segments, True, band,
+        )  # fmt: skip
+        for row, n in enumerate(exact):
+            length = len(references[codes[n]])
+            warps[n] = position_warp(positions[row, :length], len(series[n]), smoothing)
+    for n in sorted(set(range(len(series))) - set(exact)):
+        reference = references[codes[n]]
+        if window is None:
+            path, _ = multiscale_path(reference, series[n], manifold, squared=True)
+        else:
+            path, _ = path_indices(reference, series[n], manifold, band, squared=True)
+        warps[n] = path_warp(path, len(reference), len(series[n]), smoothing)
+    return warps
+
+
+def _stack(arrays: list[np.ndarray]) -> np.ndarray:
+    """Series of points as one zero-padded ``(n, T_max, p)`` float64 array."""
+    out = np.zeros((len(arrays), max(len(a) for a in arrays), int(np.prod(arrays[0].shape[1:]))))
+    for k, a in enumerate(arrays):
+        out[k, : len(a)] = a.reshape(len(a), -1)
+    return out

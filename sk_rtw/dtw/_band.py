@@ -176,6 +176,11 @@ def _band_costs(x, y, lo, hi, manifold, squared) -> np.ndarray:
     return cost
 
 
+def solved_exactly(nx: int, ny: int, radius: int = RADIUS, exact_cells: int = EXACT_CELLS):
+    """Whether :func:`multiscale_path` solves a pair of these lengths exactly (no band)."""
+    return nx * ny <= exact_cells or min(nx, ny) <= 2 * radius + 2
+
+
 def multiscale_path(
     x: np.ndarray,
     y: np.ndarray,
@@ -208,7 +213,7 @@ def multiscale_path(
     from ._dtw import point_cost_matrix
     from ._paths import optimal_path
 
-    if len(x) * len(y) <= exact_cells or min(len(x), len(y)) <= 2 * radius + 2:
+    if solved_exactly(len(x), len(y), radius, exact_cells):
         return optimal_path(point_cost_matrix(x, y, manifold, squared))
     coarse, _ = multiscale_path(halve(x, manifold), halve(y, manifold), manifold, squared,
                                 radius, exact_cells)  # fmt: skip

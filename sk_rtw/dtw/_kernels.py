@@ -454,6 +454,21 @@ def ragged_value(values, offsets, starts, i, j):
     return values[offsets[i] + k]
 
 
+@njit(cache=True, inline="always")
+def _ragged_step(values, offsets, starts, i, j):
+    """The cell before ``(i, j)`` on the optimal path through stored rows."""
+    if i == 0:
+        return i, j - 1
+    if j == 0:
+        return i - 1, j
+    return choose_step(
+        i, j,
+        ragged_value(values, offsets, starts, i - 1, j - 1),
+        ragged_value(values, offsets, starts, i - 1, j),
+        ragged_value(values, offsets, starts, i, j - 1),
+    )  # fmt: skip
+
+
 @njit(cache=True)
 def ragged_backtrack(values, offsets, starts, ny):
     """The optimal path ``(P, 2)`` through :func:`accumulated_segment_cost`'s rows, ties
@@ -464,17 +479,7 @@ def ragged_backtrack(values, offsets, starts, ny):
     n = 0
     path[n, 0], path[n, 1] = i, j
     while i > 0 or j > 0:
-        if i == 0:
-            j -= 1
-        elif j == 0:
-            i -= 1
-        else:
-            i, j = choose_step(
-                i, j,
-                ragged_value(values, offsets, starts, i - 1, j - 1),
-                ragged_value(values, offsets, starts, i - 1, j),
-                ragged_value(values, offsets, starts, i, j - 1),
-            )  # fmt: skip
+        i, j = _ragged_step(values, offsets, starts, i, j)
         n += 1
         path[n, 0], path[n, 1] = i, j
     return path[: n + 1][::-1].copy()
@@ -516,3 +521,36 @@ def pairwise_segments(X, lx, Y, ly, segments, squared, window, symmetric, bounds
             for j in range(i):
                 values[i, j] = values[j, i]
     return values
+
+
+@njit(cache=True)
+def matched_positions(references, reference_lengths, X, lengths, codes, segments, squared,
+                      window):  # fmt: skip
+    """For every series, the mean index of its samples matched with each sample of its
+    reference on their optimal DTW path (the path of :func:`accumulated_segment_cost`
+    without a bound, ties broken as :func:`backtrack` breaks them).
+
+    ``references`` ``(G, L, p)`` with ``reference_lengths``; series ``X`` ``(N, T, p)``
+    with ``lengths``, series ``n`` aligned to reference ``codes[n]``. Returns ``(N, L)``:
+    row ``n`` holds ``reference_lengths[codes[n]]`` values (the rest is zero). One pass,
+    no path stored: every pair costs its DTW and nothing else.
+    """
+    n = X.shape[0]
+    out = np.zeros((n, references.shape[1]))
+    counts = np.zeros(references.shape[1])
+    for k in range(n):
+        reference = references[codes[k], : reference_lengths[codes[k]]]
+        nx, ny = reference.shape[0], lengths[k]
+        values, offsets, starts = accumulated_segment_cost(
+            reference, X[k, :ny], segments, squared, window, _INF
+        )
+        counts[:nx] = 0.0
+        i, j = nx - 1, ny - 1
+        out[k, i], counts[i] = j, 1.0
+        while i > 0 or j > 0:
+            i, j = _ragged_step(values, offsets, starts, i, j)
+            out[k, i] += j
+            counts[i] += 1.0
+        for i in range(nx):
+            out[k, i] /= counts[i]
+    return out
