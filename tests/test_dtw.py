@@ -298,18 +298,41 @@ def test_pairwise_distances_with_bounds_equal_those_without(rng):
     """Bounds from any path (close, poor, or too low to be a path's cost) give the same
     distances: a bound under the distance is detected and the pair computed again."""
     from sk_rtw.dtw import _kernels
-    from sk_rtw.dtw._dtw import _pairwise
-    from sk_rtw.utils import check_series_collection
 
     Q = Quaternion()
     X = np.stack([random_walk(Q, 40, seed) for seed in range(5)])
-    collection = check_series_collection(X, Q)
+    lengths, segments = np.full(5, 40), _kernels.segment_codes(Q)
     for window in (None, 0.3):
         plain = dtw_pairwise_distance(X, manifold=Q, squared=True, window=window)
+        w = -1.0 if window is None else window
         for scale in (1.0, 1.5, 0.5, 0.0):
             bounds = plain * scale + (rng.random(plain.shape) * 1e-3 if scale else 0.0)
-            w = -1.0 if window is None else window
-            got = _pairwise(collection, collection, w, True, True, False, bounds)
+            got = _kernels.pairwise_segments(X, lengths, X, lengths, segments, True, w, True,
+                                             bounds)  # fmt: skip
             np.testing.assert_array_equal(got, plain)
     low = plain[0, 1] * 0.5
-    assert _kernels.pruned_distance(X[0], X[1], _kernels.segment_codes(Q), True, -1.0, low) > low
+    assert _kernels.pruned_distance(X[0], X[1], segments, True, -1.0, low) > low
+
+
+def test_long_pairs_are_bounded_by_their_coarse_to_fine_path_with_the_same_result():
+    """Past 2**20 cells without a band, dtw_distance, dtw_path and dtw_pairwise_distance
+    bound each pair by its coarse-to-fine path (two rows of memory, most cells skipped)
+    and return what the full recursion returns, bit for bit."""
+    from sk_rtw.datasets import make_warped_signals
+    from sk_rtw.dtw import _kernels
+    from sk_rtw.dtw._band import guide_bound
+
+    Q = Quaternion()
+    X = np.asarray(make_warped_signals("quaternion", 3, 1100, random_state=2).signals)
+    X = [X[0], X[1][:1050], X[2]]
+    segments = _kernels.segment_codes(Q)
+    full = np.array([[_kernels.pruned_distance(a, b, segments, False, -1.0, np.inf)
+                      for b in X] for a in X])  # fmt: skip
+    assert np.isfinite(guide_bound(X[0], X[1], Q, -1.0, False))  # long: a guide is used
+    assert guide_bound(X[0], X[1], Q, 0.5, False) == np.inf  # in a band: none
+    assert dtw_distance(X[0], X[1], Q) == full[0, 1]
+    path, cost = dtw_path(X[0], X[1], Q)
+    assert cost == full[0, 1] and path[0] == (0, 0) and path[-1] == (1099, 1049)
+    symmetric = np.triu(full, 1) + np.triu(full, 1).T  # X against itself: the upper pairs
+    np.testing.assert_array_equal(dtw_pairwise_distance(X, manifold=Q), symmetric)
+    np.testing.assert_array_equal(dtw_pairwise_distance(X, X[:2], manifold=Q), full[:, :2])

@@ -31,6 +31,11 @@ EXACT_CELLS = 2**20
 #: Half-width of the band around the projected coarser path, in samples of each level.
 RADIUS = 16
 
+#: Relative margin on a guide path's cost: the recursion adds the same point costs in
+#: the same order (no margin needed in exact arithmetic); this one covers a last-bit
+#: difference between two compiled copies of the point cost.
+GUIDE_SLACK = 1e-9
+
 
 @njit(cache=True)
 def band_from_path(path, nx, ny, radius):
@@ -163,9 +168,7 @@ def _band_costs(x, y, lo, hi, manifold, squared) -> np.ndarray:
     width = int((hi - lo).max())
     segments = _kernels.segment_codes(manifold)
     if segments is not None:
-        flat_x = np.ascontiguousarray(x.reshape(len(x), -1))
-        flat_y = np.ascontiguousarray(y.reshape(len(y), -1))
-        return band_segment_costs(flat_x, flat_y, lo, hi, segments, squared, width)
+        return band_segment_costs(_flatten(x), _flatten(y), lo, hi, segments, squared, width)
     rows = np.repeat(np.arange(len(x)), hi - lo)
     offsets = np.arange(rows.size) - np.repeat(np.cumsum(hi - lo) - (hi - lo), hi - lo)
     cols = lo[rows] + offsets
@@ -220,3 +223,32 @@ def multiscale_path(
     lo, hi = band_from_path(coarse, len(x), len(y), radius)
     D = band_accumulate(_band_costs(x, y, lo, hi, manifold, squared), lo, hi)
     return band_backtrack(D, lo, hi), float(D[-1, hi[-1] - 1 - lo[-1]])
+
+
+def guide_bound(
+    x: np.ndarray,
+    y: np.ndarray,
+    manifold: Manifold,
+    window: float,
+    squared: bool,
+    guide: np.ndarray | None = None,
+) -> float:
+    """The cost of ``guide``, a warping path between two validated series (default: their
+    :func:`multiscale_path` if they are long, over :data:`EXACT_CELLS` cells, and have no
+    band): a bound that lets the exact DTW skip most cells. ``inf`` without a guide or a
+    kernel distance."""
+    segments = _kernels.segment_codes(manifold)
+    if segments is None:
+        return np.inf
+    if guide is None and (window < 0.0 or window >= 1.0) and len(x) * len(y) > EXACT_CELLS:
+        guide = multiscale_path(x, y, manifold, squared)[0]
+    if guide is None:
+        return np.inf
+    flat_x, flat_y = _flatten(x), _flatten(y)
+    cost = _kernels.path_cost(flat_x, flat_y, np.asarray(guide, dtype=np.int64), segments,
+                              squared)  # fmt: skip
+    return cost * (1.0 + GUIDE_SLACK)
+
+
+def _flatten(x: np.ndarray) -> np.ndarray:
+    return np.ascontiguousarray(x.reshape(len(x), -1))

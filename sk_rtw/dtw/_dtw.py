@@ -16,6 +16,7 @@ from .._numba import numba_threads
 from ..manifolds import Manifold
 from ..utils import SeriesCollection, check_series, check_series_collection
 from . import _kernels
+from ._band import EXACT_CELLS, guide_bound
 
 _NORMALIZE = (None, "path")
 
@@ -112,6 +113,20 @@ def check_costs(
     )
 
 
+def _guide_bounds(
+    cx: SeriesCollection, cy: SeriesCollection, window: float, squared: bool, symmetric: bool
+) -> np.ndarray:
+    """:func:`~sk_rtw.dtw._band.guide_bound` of every pair (``inf`` where none: short
+    pairs, a band; the upper triangle if ``symmetric``)."""
+    bounds = np.full((cx.n_series, cy.n_series), np.inf)
+    if cx.max_length * cy.max_length <= EXACT_CELLS or 0.0 <= window < 1.0:
+        return bounds  # no pair gets a guide: skip the loop
+    for i in range(cx.n_series):
+        for j in range(i + 1 if symmetric else 0, cy.n_series):
+            bounds[i, j] = guide_bound(cx.series(i), cy.series(j), cx.manifold, window, squared)
+    return bounds
+
+
 def _flat(x: np.ndarray) -> np.ndarray:
     """A validated series ``(T, *point_shape)`` as ``(T, prod(point_shape))``."""
     return np.ascontiguousarray(x.reshape(x.shape[0], -1))
@@ -191,11 +206,20 @@ def dtw_distance(
     _check_normalize(normalize)
     w = check_window(window)
     x, y, manifold = _pair(x, y, manifold)
-    cost = point_cost_matrix(x, y, manifold, squared)
     if normalize == "path":
-        D = _kernels.accumulated_cost(cost, w)
-        return float(D[-1, -1] / _kernels.path_length(D))
-    return float(_kernels.final_cost(cost, len(x), len(y), w))
+        path, cost = _paths().path_indices(x, y, manifold, w, squared)
+        return float(cost / len(path))
+    segments = _kernels.segment_codes(manifold)
+    if segments is None:
+        return float(_kernels.final_cost(point_cost_matrix(x, y, manifold, squared),
+                                         len(x), len(y), w))  # fmt: skip
+    # two rows of memory; long pairs without a band skip the cells that cannot beat their
+    # coarse-to-fine path (the same value)
+    bound = guide_bound(x, y, manifold, w, squared)
+    value = _kernels.pruned_distance(_flat(x), _flat(y), segments, squared, w, bound)
+    if not value <= bound:
+        value = _kernels.pruned_distance(_flat(x), _flat(y), segments, squared, w, np.inf)
+    return float(value)
 
 
 def dtw_path(
@@ -223,9 +247,15 @@ def dtw_path(
     """
     w = check_window(window)
     x, y, manifold = _pair(x, y, manifold)
-    D = _kernels.accumulated_cost(point_cost_matrix(x, y, manifold, squared), w)
-    path = [(int(i), int(j)) for i, j in _kernels.backtrack(D)]
-    return path, float(D[-1, -1])
+    path, cost = _paths().path_indices(x, y, manifold, w, squared)
+    return [(int(i), int(j)) for i, j in path], cost
+
+
+def _paths():
+    """:mod:`sk_rtw.dtw._paths`, which builds on this module."""
+    from . import _paths
+
+    return _paths
 
 
 def dtw_pairwise_distance(
@@ -281,19 +311,16 @@ def _pairwise(
     squared,
     symmetric,
     per_step,
-    bounds: np.ndarray | None = None,
 ) -> np.ndarray:
-    """The distances of :func:`dtw_pairwise_distance`; ``bounds[i, j]``, the cost of some
-    path between the pair, lets the kernels skip the cells that cannot beat it (same
-    result)."""
+    """The distances of :func:`dtw_pairwise_distance` (long pairs without a band skip the
+    cells that cannot beat their coarse-to-fine path: :func:`_guide_bounds`)."""
     manifold = cx.manifold
     segments = _kernels.segment_codes(manifold)
     if segments is not None:
         flat_x = np.ascontiguousarray(cx.data.reshape(cx.n_series, cx.max_length, -1))
         flat_y = np.ascontiguousarray(cy.data.reshape(cy.n_series, cy.max_length, -1))
         if not per_step:
-            if bounds is None:
-                bounds = np.full((cx.n_series, cy.n_series), np.inf)
+            bounds = _guide_bounds(cx, cy, window, squared, symmetric)
             return _kernels.pairwise_segments(
                 flat_x, cx.lengths, flat_y, cy.lengths, segments, squared, window, symmetric,
                 bounds,

@@ -12,13 +12,8 @@ from .._numba import numba_threads
 from ..manifolds import Manifold
 from ..utils import SeriesCollection
 from . import _kernels
-from ._band import EXACT_CELLS, multiscale_path
+from ._band import guide_bound
 from ._dtw import _flat, _pairwise, check_window, point_cost_matrix
-
-#: Relative margin on a guide path's cost: the recursion adds the same point costs in
-#: the same order, so no margin is needed in exact arithmetic; this one covers a last-bit
-#: difference between two compiled copies of the point cost.
-GUIDE_SLACK = 1e-9
 
 
 def optimal_path(cost: np.ndarray, window: float = -1.0) -> tuple[np.ndarray, float]:
@@ -82,12 +77,7 @@ def path_indices(
     # the point costs are computed inside the accumulation (the T_x x T_y cost matrix is
     # never stored) and only where a path could still beat the guide's cost
     fx, fy = _flat(x), _flat(y)
-    if guide is None and (window < 0.0 or window >= 1.0) and len(x) * len(y) > EXACT_CELLS:
-        guide = multiscale_path(x, y, manifold, squared)[0]  # close, and cheap next to this
-    bound = np.inf
-    if guide is not None:
-        bound = _kernels.path_cost(fx, fy, np.asarray(guide, dtype=np.int64), segments, squared)
-        bound *= 1.0 + GUIDE_SLACK
+    bound = guide_bound(x, y, manifold, window, squared, guide)
     rows = _kernels.accumulated_segment_cost(fx, fy, segments, squared, window, bound)
     cost = _kernels.ragged_value(*rows, len(x) - 1, len(y) - 1)
     if not cost <= bound:  # the guide left the band, or a cost is not finite
@@ -124,27 +114,6 @@ def medoid_index(
     index = np.arange(collection.n_series) if candidates is None else np.asarray(candidates)
     subset = collection.subset(index)
     w = check_window(window)
-    bounds = _guide_bounds(subset, w, squared)
     with numba_threads(None):  # as dtw_pairwise_distance's default: one thread
-        D = _pairwise(subset, subset, w, squared, True, False, bounds)
+        D = _pairwise(subset, subset, w, squared, True, False)
     return int(index[np.argmin(D.sum(1))])
-
-
-def _guide_bounds(collection: SeriesCollection, window: float, squared: bool):
-    """The cost of the coarse-to-fine path of every pair of long series (more than
-    ``2**20`` cells) without a band, ``inf`` for the others: bounds that let the exact
-    pairwise DTW skip most cells (:func:`path_indices`' default guide, pair by pair)."""
-    n = collection.n_series
-    bounds = np.full((n, n), np.inf)
-    segments = _kernels.segment_codes(collection.manifold)
-    if segments is None or 0.0 <= window < 1.0:
-        return bounds
-    series = [collection.series(i) for i in range(n)]
-    for i in range(n):
-        for j in range(i + 1, n):
-            x, y = series[i], series[j]
-            if len(x) * len(y) > EXACT_CELLS:
-                path = multiscale_path(x, y, collection.manifold, squared)[0]
-                cost = _kernels.path_cost(_flat(x), _flat(y), path, segments, squared)
-                bounds[i, j] = cost * (1.0 + GUIDE_SLACK)
-    return bounds
