@@ -28,8 +28,9 @@ Quality: the path-normalised geodesic DTW distance between the mean and the clea
 trajectory the series were warped from (both resampled to 2,000 samples, band 10 %;
 lower is better): how well the mean recovers the demonstrated motion. Seconds are the
 fit only (each method first runs once on the first 1,100 samples of two series, so that
-compiled kernels are loaded, or compiled on a first run); peak memory is the process's maximum resident set (data and imports included).
-Results are kept per run in ``--out`` (a rerun skips what is there).
+compiled kernels are loaded, or compiled on a first run); peak memory is the process's
+maximum resident set (data and imports included). Results are kept per run in
+``--out`` (a rerun skips what is there).
 """
 
 from __future__ import annotations

@@ -402,6 +402,16 @@ def pruned_distance(x, y, segments, squared, window, bound):
     cells that cannot beat ``bound`` skipped as in :func:`accumulated_segment_cost`:
     exact when at most ``bound``, otherwise some value above it (``inf`` if the bound
     was too low)."""
+    if bound == _INF:  # the plain recursion, without the pruning's bookkeeping per row
+        lo, hi = sakoe_chiba_rows(x.shape[0], y.shape[0], window)
+        prev, cur = _two_rows(y.shape[0])
+        costs = np.empty(y.shape[0])
+        for i in range(x.shape[0]):
+            _cost_row(x, y[lo[i] : hi[i]], i, hi[i] - lo[i], segments, squared,
+                      costs[lo[i] : hi[i]])  # fmt: skip
+            _band_row(costs, prev, cur, lo[i], hi[i])
+            prev, cur = cur, prev
+        return prev[y.shape[0]]
     return _pruned_rows(x, y, segments, squared, window, bound, False)[3]
 
 
@@ -413,9 +423,10 @@ def _pruned_rows(x, y, segments, squared, window, bound, store):
     lo, hi = sakoe_chiba_rows(nx, ny, window)
     prev, cur = _two_rows(ny)
     costs = np.empty(ny)
+    rows = nx if store else 0  # a distance alone allocates nothing per row
     values = np.empty(min(nx * ny, max(1 << 16, 64 * (nx + ny))) if store else 0)
-    offsets = np.zeros(nx + 1, dtype=np.int64)
-    starts = np.zeros(nx, dtype=np.int64)
+    offsets = np.zeros(rows + 1, dtype=np.int64)
+    starts = np.zeros(rows, dtype=np.int64)
     start, reach = 0, 0  # row -1 keeps only its sentinel (column -1)
     prev_end, cur_end = 0, 0  # the last padded entry each buffer holds a value in
     for i in range(nx):
@@ -438,11 +449,11 @@ def _pruned_rows(x, y, segments, squared, window, bound, store):
         if first < 0:  # no cell of this row is kept: nor is the last cell
             if store:
                 offsets[i + 2 :] = offsets[i + 1]
-            return values[: offsets[nx]], offsets, starts, _INF
+            return values[: offsets[rows]], offsets, starts, _INF
         start, reach = first, last + 1
         prev, cur = cur, prev
         prev_end, cur_end = cur_end, prev_end
-    return values[: offsets[nx]], offsets, starts, prev[ny]
+    return values[: offsets[rows]], offsets, starts, prev[ny]
 
 
 @njit(cache=True, inline="always")
