@@ -115,13 +115,20 @@ def _band_row(cost_row, prev, cur, lo, hi):
     cur[lo] = _INF
     left = _INF
     for j in range(lo, hi):
-        best = prev[j]
-        if prev[j + 1] < best:
-            best = prev[j + 1]
-        if left < best:
-            best = left
-        left = cost_row[j] + best
+        left = _cell(prev, left, j, cost_row[j])
         cur[j + 1] = left
+
+
+@njit(cache=True)
+def _cell(prev, left, j, cost):
+    """The recursion at column ``j``: ``cost`` plus the least of the cells above-left
+    (``prev[j]``), above (``prev[j + 1]``) and left, in padded rows."""
+    best = prev[j]
+    if prev[j + 1] < best:
+        best = prev[j + 1]
+    if left < best:
+        best = left
+    return cost + best
 
 
 @njit(cache=True, inline="always")
@@ -359,12 +366,7 @@ def _pruned_row(x, y, i, prev, cur, costs, lo, hi, reach, bound, segments, squar
         stop = min(hi, chunk + PRUNE_CHUNK)
         _cost_row(x, y[chunk:stop], i, stop - chunk, segments, squared, costs[chunk:stop])
         for j in range(chunk, stop):
-            best = prev[j]
-            if prev[j + 1] < best:
-                best = prev[j + 1]
-            if left < best:
-                best = left
-            left = costs[j] + best
+            left = _cell(prev, left, j, costs[j])
             cur[j + 1] = left
             if left <= bound:
                 if first < 0:
