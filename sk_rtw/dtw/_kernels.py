@@ -1,8 +1,10 @@
 """Numba kernels: the DTW recursion over a cost matrix, band, backtracking, cost matrices.
 
 The recursion ``D[i, j] = C[i, j] + min(D[i-1, j], D[i, j-1], D[i-1, j-1])`` is written
-once (:func:`_band_row`) and used by every public function. ``fastmath`` is never
-enabled: the band uses ``inf`` for forbidden cells.
+once (:func:`_cell`) and used by every public function, ties on the way back broken once
+(:func:`choose_step`). ``fastmath`` is never enabled: the band uses ``inf`` for forbidden
+cells. Given the cost of some path (a bound), the rows skip the cells that cannot beat
+it and store only what they compute (:func:`_pruned_row`): the result is the same.
 
 Point distances that numba computes itself are described by "segments" ``(start, stop,
 code)`` of a flattened point, translated by :func:`segment_codes` from the manifold's
