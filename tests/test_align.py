@@ -828,7 +828,11 @@ def test_the_dtw_starts_path_warps_are_those_of_each_pairs_path(manifold, window
     M, series = data.manifold, [s[: 50 - 3 * n] for n, s in enumerate(data.signals)]
     references = [data.signals[0][:44], data.signals[1][::2]]
     codes = np.array([0, 1, 0, 1, 1])
-    got = _path_warps(references, series, codes, M, window, None)
+    stacked = np.zeros((5, 50, int(np.prod(series[0].shape[1:]))))
+    for n, s in enumerate(series):
+        stacked[n, : len(s)] = s.reshape(len(s), -1)
+    lengths = np.array([len(s) for s in series])
+    got = _path_warps(references, series, (stacked, lengths), codes, M, window, None)
     for n, s in enumerate(series):
         reference = references[codes[n]]
         if window is None:

@@ -226,10 +226,12 @@ def dtw_start(
     # later references: the group mean at the output length
     ref_points = [n_points for _ in members]
     codes = layout.codes.cpu().numpy()
+    stacked = (collection.data.reshape(collection.n_series, collection.max_length, -1),
+               collection.lengths)  # fmt: skip
     along: list[np.ndarray] = []
     for round_ in range(rounds):
         previous = list(along)
-        along = _path_warps(references, series, codes, manifold, window, smoothing)
+        along = _path_warps(references, series, stacked, codes, manifold, window, smoothing)
         if round_ == rounds - 1 or (
             round_ > 1 and all(np.array_equal(a, b) for a, b in zip(along, previous, strict=True))
         ):  # a fixed point: the next reference would be this one again
@@ -254,6 +256,7 @@ def dtw_start(
 def _path_warps(
     references: list[np.ndarray],
     series: list[np.ndarray],
+    stacked: tuple[np.ndarray, np.ndarray],
     codes: np.ndarray,
     manifold: Manifold,
     window: float | None,
@@ -265,7 +268,8 @@ def _path_warps(
     The pairs whose path is exact (a band, or short enough for
     :func:`~sk_rtw.dtw._band.multiscale_path` to solve them exactly) go through one
     compiled pass (:func:`~sk_rtw.dtw._kernels.matched_positions`: the same paths, no
-    Python per pair); the others one by one.
+    Python per pair); the others one by one. ``stacked``: the same series as one padded
+    ``(N, T_max, p)`` array and their lengths.
     """
     band = check_window(window)
     segments = segment_codes(manifold)
@@ -278,7 +282,7 @@ def _path_warps(
     if exact:
         positions = matched_positions(
             _stack(references), np.array([len(r) for r in references]),
-            _stack([series[n] for n in exact]), np.array([len(series[n]) for n in exact]),
+            np.ascontiguousarray(stacked[0][exact]), stacked[1][exact],
             codes[exact], segments, True, band,
         )  # fmt: skip
         for row, n in enumerate(exact):
@@ -295,7 +299,7 @@ def _path_warps(
 
 
 def _stack(arrays: list[np.ndarray]) -> np.ndarray:
-    """Series of points as one zero-padded ``(n, T_max, p)`` float64 array."""
+    """The references (a few) as one zero-padded ``(G, L_max, p)`` float64 array."""
     out = np.zeros((len(arrays), max(len(a) for a in arrays), int(np.prod(arrays[0].shape[1:]))))
     for k, a in enumerate(arrays):
         out[k, : len(a)] = a.reshape(len(a), -1)

@@ -168,7 +168,7 @@ def _band_costs(x, y, lo, hi, manifold, squared) -> np.ndarray:
     width = int((hi - lo).max())
     segments = _kernels.segment_codes(manifold)
     if segments is not None:
-        return band_segment_costs(_flatten(x), _flatten(y), lo, hi, segments, squared, width)
+        return band_segment_costs(_flat(x), _flat(y), lo, hi, segments, squared, width)
     rows = np.repeat(np.arange(len(x)), hi - lo)
     offsets = np.arange(rows.size) - np.repeat(np.cumsum(hi - lo) - (hi - lo), hi - lo)
     cols = lo[rows] + offsets
@@ -244,11 +244,11 @@ def guide_bound(
         guide = multiscale_path(x, y, manifold, squared)[0]
     if guide is None:
         return np.inf
-    flat_x, flat_y = _flatten(x), _flatten(y)
-    cost = _kernels.path_cost(flat_x, flat_y, np.asarray(guide, dtype=np.int64), segments,
+    cost = _kernels.path_cost(_flat(x), _flat(y), np.asarray(guide, dtype=np.int64), segments,
                               squared)  # fmt: skip
     return cost * (1.0 + GUIDE_SLACK)
 
 
-def _flatten(x: np.ndarray) -> np.ndarray:
-    return np.ascontiguousarray(x.reshape(len(x), -1))
+def _flat(x: np.ndarray) -> np.ndarray:
+    """A validated series ``(T, *point_shape)`` as ``(T, prod(point_shape))``."""
+    return np.ascontiguousarray(x.reshape(x.shape[0], -1))

@@ -16,7 +16,7 @@ from .._numba import numba_threads
 from ..manifolds import Manifold
 from ..utils import SeriesCollection, check_series, check_series_collection
 from . import _kernels
-from ._band import EXACT_CELLS, guide_bound
+from ._band import EXACT_CELLS, _flat, guide_bound
 
 _NORMALIZE = (None, "path")
 
@@ -127,11 +127,6 @@ def _guide_bounds(
     return bounds
 
 
-def _flat(x: np.ndarray) -> np.ndarray:
-    """A validated series ``(T, *point_shape)`` as ``(T, prod(point_shape))``."""
-    return np.ascontiguousarray(x.reshape(x.shape[0], -1))
-
-
 def _pair(x, y, manifold) -> tuple[np.ndarray, np.ndarray, Manifold]:
     x, checked = check_series(x, manifold, name="x", min_length=1)
     y, _ = check_series(y, checked, name="y", min_length=1)
@@ -216,9 +211,10 @@ def dtw_distance(
     # two rows of memory; long pairs without a band skip the cells that cannot beat their
     # coarse-to-fine path (the same value)
     bound = guide_bound(x, y, manifold, w, squared)
-    value = _kernels.pruned_distance(_flat(x), _flat(y), segments, squared, w, bound)
+    fx, fy = _flat(x), _flat(y)
+    value = _kernels.pruned_distance(fx, fy, segments, squared, w, bound)
     if not value <= bound:
-        value = _kernels.pruned_distance(_flat(x), _flat(y), segments, squared, w, np.inf)
+        value = _kernels.pruned_distance(fx, fy, segments, squared, w, np.inf)
     return float(value)
 
 
@@ -305,12 +301,7 @@ def dtw_pairwise_distance(
 
 
 def _pairwise(
-    cx: SeriesCollection,
-    cy: SeriesCollection,
-    window,
-    squared,
-    symmetric,
-    per_step,
+    cx: SeriesCollection, cy: SeriesCollection, window, squared, symmetric, per_step
 ) -> np.ndarray:
     """The distances of :func:`dtw_pairwise_distance` (long pairs without a band skip the
     cells that cannot beat their coarse-to-fine path: :func:`_guide_bounds`)."""

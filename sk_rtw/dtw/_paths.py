@@ -8,12 +8,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._numba import numba_threads
 from ..manifolds import Manifold
 from ..utils import SeriesCollection
 from . import _kernels
-from ._band import guide_bound
-from ._dtw import _flat, _pairwise, check_window, point_cost_matrix
+from ._band import _flat, guide_bound
+from ._dtw import dtw_pairwise_distance, point_cost_matrix
 
 
 def optimal_path(cost: np.ndarray, window: float = -1.0) -> tuple[np.ndarray, float]:
@@ -112,8 +111,5 @@ def medoid_index(
         Index into ``collection``.
     """
     index = np.arange(collection.n_series) if candidates is None else np.asarray(candidates)
-    subset = collection.subset(index)
-    w = check_window(window)
-    with numba_threads(None):  # as dtw_pairwise_distance's default: one thread
-        D = _pairwise(subset, subset, w, squared, True, False)
+    D = dtw_pairwise_distance(collection.subset(index), window=window, squared=squared)
     return int(index[np.argmin(D.sum(1))])
