@@ -484,6 +484,44 @@ def test_trainer_stops_each_group_on_its_own_and_keeps_its_best():
     assert np.isnan(both.history[runs[0] :, 0].numpy()).all()
 
 
+def test_a_narrowed_trainer_goes_on_as_the_whole_one_would():
+    """Pause once a group has stopped, narrow to the running groups (their parameters,
+    best iterates, counters, history and Adam moments carried over), finish: the same
+    epochs, best epochs, history and final parameters as the uninterrupted run."""
+    floors = torch.tensor([1.0, -50.0, 0.0])
+
+    def make(weight, groups):
+        def loss_fn():
+            values = (weight[:, 0] - floors[groups]).abs().clamp_min(0.5)
+            return values.sum(), values
+
+        return Trainer(loss_fn, [weight], 150, 0.1, parameter_groups=[torch.arange(len(groups))],
+                       n_groups=len(groups), n_iter_no_change=5, tol=1e-4)  # fmt: skip
+
+    whole_weight = torch.nn.Parameter(torch.full((3, 1), 3.0))
+    whole = make(whole_weight, torch.arange(3))
+    whole.run(lambda done, history: None, 50)
+
+    weight = torch.nn.Parameter(torch.full((3, 1), 3.0))
+    trainer = make(weight, torch.arange(3))
+    assert trainer.run(lambda done, history: None, 50, pause=lambda a: not bool(a.all())) is None
+    paused_at = trainer.epochs_done
+    keep = torch.nonzero(trainer.active).flatten()
+    stopped = torch.nonzero(~trainer.active).flatten()
+    assert 0 < paused_at < 150 and 0 < len(keep) < 3
+    frozen = trainer.best[0][stopped].clone()
+    part = torch.nn.Parameter(weight.detach()[keep].clone())
+    narrowed = trainer.narrow(keep, make(part, keep).loss_fn, [part], [torch.arange(len(keep))])
+    narrowed.run(lambda done, history: None, 50)
+    assert narrowed.epochs_done > paused_at
+    np.testing.assert_array_equal(narrowed.epochs_run.numpy(), whole.epochs_run[keep].numpy())
+    np.testing.assert_array_equal(narrowed.best_epoch.numpy(), whole.best_epoch[keep].numpy())
+    np.testing.assert_array_equal(narrowed.history.numpy(), whole.history[:, keep].numpy())
+    np.testing.assert_array_equal(part.detach().numpy(), whole_weight.detach()[keep].numpy())
+    np.testing.assert_array_equal(frozen.numpy(), whole_weight.detach()[stopped].numpy())
+    np.testing.assert_array_equal(narrowed.group_ids, keep.numpy())
+
+
 def test_early_stopping_saves_epochs_and_keeps_the_best():
     data = make_warped_signals("euclidean", 6, 40, 1)
     full = align(data.signals, n_iter_no_change=None, n_epochs=120, random_state=0)
@@ -674,6 +712,43 @@ def test_groups_in_one_batch_equal_separate_fits(method):
         np.testing.assert_allclose(batch[g].warps, alone.warps, atol=1e-9)
         np.testing.assert_allclose(batch[g].mean, alone.mean, atol=1e-9)
         np.testing.assert_allclose(batch[g].loss_history, alone.loss_history, rtol=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("method", "preset"),
+    [("rtw", "class-means"), ("rtw", "alignment"), ("ttw", "class-means"), ("ntw", "alignment")],
+)
+def test_narrowing_the_batch_to_the_running_groups_changes_no_result(method, preset, monkeypatch):
+    """Groups that stop early leave the batch (the engine narrows it once half have
+    stopped): every group's result is that of the whole batch run to the end."""
+    from sk_rtw.align import _engine
+    from sk_rtw.align._config import resolve_config
+    from sk_rtw.utils import check_series_collection
+
+    series, codes = [], []
+    for g, (n, length, seed) in enumerate([(5, 40, 1), (3, 30, 2), (4, 36, 3), (2, 44, 4),
+                                           (6, 32, 5)]):  # fmt: skip
+        series += list(make_warped_signals("sphere", n, length, seed).signals)
+        codes += [g] * n
+    collection = check_series_collection(series, "sphere")
+    config = resolve_config(method, preset, {"output_length": 40, "n_epochs": 60,
+                                             "n_iter_no_change": 3, "tol": 1e-2})  # fmt: skip
+    seeds = [3, 1, 4, 1, 5]
+    subsets = []
+    original = _engine._Problem.subset
+    monkeypatch.setattr(_engine._Problem, "subset",
+                        lambda self, groups: subsets.append(len(groups)) or original(self, groups))
+    narrowed = _engine.align_collection(collection, codes, seeds, config)
+    monkeypatch.setattr(_engine, "_half_stopped", lambda active: False)
+    whole = _engine.align_collection(collection, codes, seeds, config)
+    assert subsets, "the batch was never narrowed"
+    assert len({r.n_iter for r in whole}) > 1  # the groups stopped at different epochs
+    for a, b in zip(narrowed, whole, strict=True):
+        assert a.n_iter == b.n_iter and a.best_epoch == b.best_epoch
+        np.testing.assert_allclose(a.warps, b.warps, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(a.mean, b.mean, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(a.loss_history, b.loss_history, rtol=1e-12)
+        assert a.cost == pytest.approx(b.cost, rel=1e-12)
 
 
 def test_group_layout_sums_and_broadcasts():

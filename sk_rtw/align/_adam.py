@@ -45,6 +45,17 @@ class FusedAdam:
         self.eps = float(eps)
         self._state: dict[int, tuple[torch.Tensor, torch.Tensor, torch.Tensor]] = {}
 
+    def narrow(
+        self, parameters: Sequence[torch.Tensor], rows: Sequence[torch.Tensor]
+    ) -> FusedAdam:
+        """Adam over ``parameters``, the ``rows`` of this one's parameters (indices along
+        their leading axis, in order), with those rows' moments and the same step count."""
+        other = FusedAdam(parameters, self.lr, self.betas, self.eps)
+        for index, (average, square, steps) in self._state.items():
+            picked = rows[index]
+            other._state[index] = (average[picked].clone(), square[picked].clone(), steps.clone())
+        return other
+
     def zero_grad(self, set_to_none: bool = True) -> None:
         """Forget the gradients (set to None, as ``torch.optim``'s default)."""
         for parameter in self.parameters:

@@ -10,9 +10,11 @@ early stop).
 
 from __future__ import annotations
 
+import copy
 import sys
 import time
 from dataclasses import dataclass, field
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -131,6 +133,20 @@ class _Problem:
         self.start: torch.Tensor | None = None
         #: The previous epoch's means (``mean_start="previous"``): the next Gauss–Newton start.
         self.warm: torch.Tensor | None = None
+
+    def subset(self, groups: torch.Tensor) -> _Problem:
+        """The problem of ``groups`` only (increasing indices): their series, starting
+        warps and warm-started means; each computed exactly as in the whole problem."""
+        layout, rows = self.layout.subset(groups)
+        other = copy.copy(self)
+        other.layout = layout
+        other.data = self.data[rows]
+        other.lengths = self.lengths[rows]
+        other.series_weight = self.series_weight[rows]
+        other.interpolate = self.interpolate.subset(rows)
+        other.start = None if self.start is None else self.start[rows]
+        other.warm = None if self.warm is None else self.warm[groups].clone()
+        return other
 
     def points_and_weights(self, warps: torch.Tensor, aligned: torch.Tensor):
         """What enters the mean: the aligned points with equal weights, or the stretch
@@ -594,24 +610,79 @@ def _optimise(
     Returns the best epoch and the number of epochs run of every group.
     """
     config = problem.config
-    parameters = list(model.parameters())
+    n_groups = problem.layout.n_groups
     trainer = Trainer(
         lambda: problem.forward(model)[:2],
-        parameters,
+        list(model.parameters()),
         config.n_epochs,
         config.learning_rate,
         parameter_groups=model.parameter_groups(),
-        n_groups=problem.layout.n_groups,
+        n_groups=n_groups,
         n_iter_no_change=config.n_iter_no_change,
         tol=config.tol,
         cuda_graph=config.cuda_graph,
     )
-    report, every = progress_printer(config.method, config.n_epochs, verbose)
-    best_epoch = trainer.run(report, every)
+    show, every = progress_printer(config.method, config.n_epochs, verbose)
+    whole = np.full(history.shape, np.nan)
+    running = torch.arange(n_groups)  # the trainer's groups, in the whole problem's numbering
+
+    def report(done: int, part: np.ndarray) -> None:
+        whole[:done, running.numpy()] = part
+        show(done, whole[:done])
+
+    best_epoch, epochs_run = np.full(n_groups, -1), np.zeros(n_groups, dtype=int)
+    narrowing = trainer.device.type == "cpu" and n_groups > 1 and hasattr(model, "subset")
+    stage_problem, stage_model = problem, model
+    while True:
+        best = trainer.run(report, every, pause=_half_stopped if narrowing else None)
+        ids = running.numpy()
+        whole[:, ids] = trainer.history.cpu().numpy()
+        best_epoch[ids] = trainer.best_epoch.cpu().numpy()
+        epochs_run[ids] = trainer.epochs_run.cpu().numpy()
+        if best is not None:  # finished: the stage model holds every group's best iterate
+            _write_back(model, stage_model, running)
+            break
+        # the stopped groups' best iterates go back to the whole model; the rest go on alone
+        stopped = torch.nonzero(~trainer.active.cpu()).flatten()
+        _write_back(model, stage_model, running[stopped], trainer.best, trainer.rows(stopped))
+        keep = torch.nonzero(trainer.active.cpu()).flatten()
+        stage_problem = stage_problem.subset(keep.to(stage_problem.layout.codes.device))
+        stage_model = stage_model.subset(keep.to(trainer.device))
+        trainer = trainer.narrow(
+            keep,
+            partial(_stage_loss, stage_problem, stage_model),
+            list(stage_model.parameters()),
+            stage_model.parameter_groups(),
+        )
+        running = running[keep]
     done = trainer.epochs_done
     note = early_stop_note(config.method, done, config.n_epochs, best_epoch,
                            config.n_iter_no_change, config.tol)  # fmt: skip
     if verbose and note:
         print(note, file=sys.stderr, flush=True)
-    history[:done] = trainer.history[:done].cpu().numpy()
-    return best_epoch, trainer.epochs_run.cpu().numpy()
+    history[:done] = whole[:done]
+    return best_epoch, epochs_run
+
+
+def _half_stopped(active: torch.Tensor) -> bool:
+    """Narrow the batch once half of its groups have stopped: a stopped group's epochs
+    are wasted work, and at most log2(groups) narrowings are paid."""
+    return 2 * int(active.sum()) <= active.numel()
+
+
+def _stage_loss(problem: _Problem, model: WarpModel):
+    return problem.forward(model)[:2]
+
+
+def _write_back(whole: WarpModel, stage: WarpModel, groups: torch.Tensor, values=None,
+                rows=None) -> None:  # fmt: skip
+    """Copy the parameters of ``groups`` (the whole model's numbering) from a narrowed
+    ``stage`` model (or from ``values`` at ``rows`` of its parameters) into ``whole``."""
+    if values is None:
+        values = list(stage.parameters())
+        rows = [torch.arange(v.shape[0], device=v.device) for v in values]
+    groups = groups.to(next(whole.parameters()).device)
+    with torch.no_grad():
+        for target, owner, value, picked in zip(whole.parameters(), whole.parameter_groups(),
+                                                values, rows, strict=True):  # fmt: skip
+            target[torch.isin(owner, groups)] = value[picked]

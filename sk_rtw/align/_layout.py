@@ -89,6 +89,17 @@ class GroupLayout:
             return values.expand(self.n_series, *values.shape[1:])
         return values.index_select(0, self.codes)
 
+    def subset(self, groups: torch.Tensor) -> tuple[GroupLayout, torch.Tensor]:
+        """The layout of ``groups`` only (increasing indices), renumbered from 0, and the
+        rows of their series in the stacked collection (stacking order kept)."""
+        renumber = torch.full((self.n_groups,), -1, dtype=torch.long, device=self.codes.device)
+        renumber[groups] = torch.arange(len(groups), device=self.codes.device)
+        codes = renumber[self.codes]
+        rows = torch.nonzero(codes >= 0).flatten()
+        layout = GroupLayout(codes=codes[rows], positions=self.positions[rows],
+                             sizes=self.sizes[groups])  # fmt: skip
+        return layout, rows
+
     def to(self, device: str | torch.device) -> GroupLayout:
         return GroupLayout(
             codes=self.codes.to(device), positions=self.positions.to(device),

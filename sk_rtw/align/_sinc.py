@@ -37,6 +37,7 @@ weights only: the tangent point is a choice of chart, found without gradient tra
 
 from __future__ import annotations
 
+import copy
 import math
 
 import torch
@@ -135,6 +136,19 @@ class SincInterpolator:
         else:
             self._taps = torch.arange(-window, window + 1, device=data.device)
         self.table = self._build_table()
+
+    def subset(self, rows: torch.Tensor) -> SincInterpolator:
+        """The interpolator of the series ``rows`` only (indices, in order), its table
+        sliced rather than rebuilt: each series is interpolated exactly as before."""
+        other = copy.copy(self)
+        other.data = self.data[rows]
+        other.lengths = self.lengths[rows]
+        other._rows = torch.arange(len(rows), device=self.data.device).view(-1, 1)
+        other._last = self._last[rows]
+        if self.window is None:
+            other._valid = self._valid[rows]
+        other.table = None if self.table is None else self.table[rows]
+        return other
 
     # ------------------------------------------------------------------ setup
     def _build_table(self) -> torch.Tensor | None:

@@ -27,6 +27,7 @@ eagerly with a warning. Graph capture is opt-in: it has not yet been checked on 
 
 from __future__ import annotations
 
+import copy
 import math
 import sys
 import warnings
@@ -99,6 +100,11 @@ class Trainer:
             groups.to(device).view(-1, *([1] * max(p.ndim - 1, 0)))
             for groups, p in zip(parameter_groups, parameters, strict=True)
         ]
+        #: Which group each of this trainer's groups is in the caller's numbering (error
+        #: messages of a narrowed trainer name the caller's groups).
+        self.group_ids = np.arange(n_groups)
+        self.whole_groups = n_groups
+        self.epochs_done = 0
         self.best = [p.detach().clone() for p in parameters]
         self.best_loss = torch.full((n_groups,), math.inf, dtype=dtype, device=device)
         self.best_epoch = torch.full((n_groups,), -1, dtype=torch.long, device=device)
@@ -145,22 +151,30 @@ class Trainer:
             self.epoch += 1
         self.optimiser.step()
 
-    def run(self, report: Callable[[int, np.ndarray], None], report_every: int) -> np.ndarray:
+    def run(
+        self,
+        report: Callable[[int, np.ndarray], None],
+        report_every: int,
+        pause: Callable[[torch.Tensor], bool] | None = None,
+    ) -> np.ndarray | None:
         """All epochs (or until every group stopped); loads each group's best parameters.
 
         ``report(done, history)`` is called every ``report_every`` epochs and at the end
         with the number of epochs done and the losses so far (``(done, n_groups)``).
+        ``pause(active)``, checked after every epoch on a CPU, may interrupt the run while
+        groups are still running: it returns None then, and :meth:`narrow` (or another
+        ``run``) continues where it stopped.
 
         Returns
         -------
-        best_epoch : ndarray of int, shape (n_groups,)
+        best_epoch : ndarray of int, shape (n_groups,), or None when paused
 
         Raises
         ------
         FloatingPointError
             As soon as a check finds a non-finite loss.
         """
-        done, graph = 0, None
+        done, graph = self.epochs_done, None
         if self.cuda and self.cuda_graph:
             done = self._warm_up(report, report_every)
             graph = self._capture() if done < self.n_epochs else None
@@ -177,11 +191,49 @@ class Trainer:
             stopped = not bool(self.active.any())
             announce = done % report_every == 0 or done == self.n_epochs or stopped
             self._check(done, report if announce else None)
+            self.epochs_done = done
+            if pause is not None and not stopped and done < self.n_epochs and pause(self.active):
+                return None
         self.epochs_done = done
         with torch.no_grad():
             for current, kept in zip(self.parameters, self.best, strict=True):
                 current.copy_(kept)
         return self.best_epoch.cpu().numpy()
+
+    def rows(self, groups: torch.Tensor) -> list[torch.Tensor]:
+        """For every parameter, the indices of its leading axis that belong to ``groups``."""
+        return [torch.isin(shape.view(-1), groups).nonzero().flatten() for shape in self._shapes]
+
+    def narrow(
+        self,
+        groups: torch.Tensor,
+        loss_fn: Callable[[], torch.Tensor | tuple[torch.Tensor, torch.Tensor]],
+        parameters: Sequence[torch.Tensor],
+        parameter_groups: Sequence[torch.Tensor],
+    ) -> Trainer:
+        """A trainer of ``groups`` only (increasing indices) that goes on where this one
+        paused: the losses of ``loss_fn`` and the ``parameters`` (with their
+        ``parameter_groups``) are those groups' alone, renumbered from 0. Best iterates,
+        counters, history and Adam's moments are carried over, so every remaining group
+        follows the trajectory it would have followed in the whole batch."""
+        groups = groups.to(self.device)
+        rows = self.rows(groups)
+        other = copy.copy(self)
+        other.loss_fn = loss_fn
+        other.parameters = list(parameters)
+        other.n_groups = len(groups)
+        other.group_ids = self.group_ids[groups.cpu().numpy()]
+        other._shapes = [
+            g.to(self.device).view(-1, *([1] * max(p.ndim - 1, 0)))
+            for g, p in zip(parameter_groups, parameters, strict=True)
+        ]
+        other.optimiser = self.optimiser.narrow(other.parameters, rows)
+        other.best = [kept[r].clone() for kept, r in zip(self.best, rows, strict=True)]
+        for name in ("best_loss", "best_epoch", "active", "stalled", "epochs_run"):
+            setattr(other, name, getattr(self, name)[groups].clone())
+        other.history = self.history[:, groups].clone()
+        other.epoch = self.epoch.clone()
+        return other
 
     # ------------------------------------------------------------------ cuda
     def _warm_up(self, report, report_every: int) -> int:
@@ -223,7 +275,7 @@ class Trainer:
             values = history[: epochs_run[g], g]
             bad = np.flatnonzero(~np.isfinite(values))
             if bad.size:
-                where = f" of group {g}" if self.n_groups > 1 else ""
+                where = f" of group {self.group_ids[g]}" if self.whole_groups > 1 else ""
                 raise FloatingPointError(
                     f"the alignment loss{where} became {values[bad[0]]} at epoch {bad[0]}; "
                     "lower learning_rate or check the data scale"

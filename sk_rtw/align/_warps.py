@@ -72,6 +72,12 @@ class WarpModel(Protocol):
         leading axis: what the trainer needs to keep each group's best iterate."""
         ...
 
+    def subset(self, groups: torch.Tensor) -> WarpModel:
+        """The warps of ``groups`` only (increasing indices): their parameters copied, every
+        remaining series computed exactly as in the whole model. The trainer narrows the
+        batch to the groups still running with it."""
+        ...
+
 
 def unit_time(n_points: int, dtype=torch.float64, device=None) -> torch.Tensor:
     """``zhat`` = ``(z - 1) / (Z - 1)`` for ``z = 1..Z``, shape (Z,)."""
@@ -257,6 +263,23 @@ class NeuralWarps(nn.Module):
         groups = torch.arange(self.layout.n_groups, device=self.w1.device)
         return [groups for _ in self.parameters()]
 
+    def subset(self, groups: torch.Tensor) -> NeuralWarps:
+        """The networks of ``groups`` only; the readout keeps its padding, so every
+        remaining series is computed exactly as in the whole model."""
+        layout, _ = self.layout.to(self.w1.device).subset(groups)
+        other = NeuralWarps.__new__(NeuralWarps)
+        nn.Module.__init__(other)
+        other.layout, other.n_signals = layout, layout.n_series
+        other.knots, other.hidden, other.n_outputs = self.knots, self.hidden, self.n_outputs
+        for name, parameter in self.named_parameters():
+            setattr(other, name, nn.Parameter(parameter.detach()[groups].clone()))
+        other.register_buffer("mask", self.mask[groups])
+        other.register_buffer("u", self.u[groups])
+        other.register_buffer("scale", self.scale[groups])
+        other.register_buffer("_rows", layout.codes * self.u.shape[1] + layout.positions)
+        other._stencil = self._stencil
+        return other
+
     def network(self, times: torch.Tensor) -> torch.Tensor:
         """``phi_theta`` of every group at ``times`` (K,): shape (n_groups, K, N_max - 1)."""
         x = times.view(1, -1, 1).expand(self.w1.shape[0], -1, 1)
@@ -330,6 +353,16 @@ class SineWarps(nn.Module):
 
     def parameter_groups(self) -> list[torch.Tensor]:
         return [self.layout.codes.to(self.coefficients.device)]
+
+    def subset(self, groups: torch.Tensor) -> SineWarps:
+        """The coefficients of the series of ``groups`` only."""
+        layout, rows = self.layout.to(self.coefficients.device).subset(groups)
+        other = SineWarps.__new__(SineWarps)
+        nn.Module.__init__(other)
+        other.layout = layout
+        other.coefficients = nn.Parameter(self.coefficients.detach()[rows].clone())
+        other._basis = self._basis
+        return other
 
     def _sines(self, zhat: torch.Tensor) -> torch.Tensor:
         key = (zhat.shape[0], zhat.device)
