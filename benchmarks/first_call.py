@@ -17,11 +17,12 @@ Every probe runs in fresh interpreters (``sys.executable``), as a user meets the
   (profiling slows everything a little: read it as proportions);
 * ``search``: ``GridSearchCV(RTWNearestCentroid(n_centroids=1, dtw_window=None), cv=3)``
   over RTW's ``hidden_size`` and DBA on aeon's GunPoint (its training split), with
-  ``n_jobs=1`` and ``n_jobs=2`` (joblib's default process workers), each searched twice in
-  the same process: the second search reuses the workers;
+  ``n_jobs=1``, ``n_jobs=2`` (joblib's default process workers) and ``n_jobs=2`` on
+  threads (``joblib.parallel_config(backend="threading")``, which starts nothing), each
+  searched twice in the same process: the second search reuses the workers;
 * ``long-search``: the default classifier searched over RTW's ``hidden_size`` x
   ``learning_rate`` and DBA (5 candidates x 3 folds) on ``--dataset`` from ``--data-dir``
-  (the development archive's Plane by default), ``n_jobs=1`` against ``n_jobs=2``.
+  (the development archive's Plane by default), the same three ways.
 
 Prints one Markdown table per probe with the median over ``--repeat`` processes.
 """
@@ -93,6 +94,7 @@ print(json.dumps({"total": total, "kernels": kernels, "imports": imports,
 SEARCH = """
 import json, sys, time
 from aeon.datasets import load_classification
+from joblib import parallel_config
 from sklearn.model_selection import GridSearchCV
 from sk_rtw import DBA, RTW, RTWNearestCentroid
 X, y = load_classification("GunPoint", split="train")
@@ -101,8 +103,9 @@ grid = [{"method": [RTW()], "method__hidden_size": [16, 64]}, {"method": [DBA()]
 times = []
 for _ in range(2):
     t = time.perf_counter()
-    GridSearchCV(RTWNearestCentroid(n_centroids=1, dtw_window=None, random_state=0),
-                 grid, cv=3, n_jobs=int(sys.argv[1])).fit(X, y)
+    with parallel_config(backend=sys.argv[2]):
+        GridSearchCV(RTWNearestCentroid(n_centroids=1, dtw_window=None, random_state=0),
+                     grid, cv=3, n_jobs=int(sys.argv[1])).fit(X, y)
     times.append(time.perf_counter() - t)
 print(json.dumps(times))
 """
@@ -111,6 +114,7 @@ print(json.dumps(times))
 LONG_SEARCH = """
 import json, sys, time
 from aeon.datasets import load_classification
+from joblib import parallel_config
 from sklearn.model_selection import GridSearchCV
 from sk_rtw import DBA, RTW, RTWNearestCentroid
 X, y = load_classification(sys.argv[2], split="train", extract_path=sys.argv[3])
@@ -118,7 +122,9 @@ X = X[:, 0, :]
 grid = [{"method": [RTW()], "method__hidden_size": [16, 64],
          "method__learning_rate": [0.01, 0.003]}, {"method": [DBA()]}]
 t = time.perf_counter()
-GridSearchCV(RTWNearestCentroid(random_state=0), grid, cv=3, n_jobs=int(sys.argv[1])).fit(X, y)
+with parallel_config(backend=sys.argv[4]):
+    GridSearchCV(RTWNearestCentroid(random_state=0), grid, cv=3,
+                 n_jobs=int(sys.argv[1])).fit(X, y)
 print(json.dumps(time.perf_counter() - t))
 """
 
@@ -165,14 +171,19 @@ def probe_split(repeat: int) -> str:
     )
 
 
+#: (n_jobs, joblib backend, label) of the search probes.
+SEARCHES = (("1", "loky", "n_jobs=1"), ("2", "loky", "n_jobs=2, processes (joblib's default)"),
+            ("2", "threading", "n_jobs=2, threads"))  # fmt: skip
+
+
 def probe_search(repeat: int) -> str:
     lines = [
         "| GridSearchCV, 3 candidates x 3 folds | first search (s) | second search (s) |",
         "| --- | --- | --- |",
     ]
-    for n_jobs in ("1", "2"):
-        runs = [fresh(SEARCH, n_jobs) for _ in range(repeat)]
-        lines.append(f"| n_jobs={n_jobs} | {median([r[0] for r in runs]):.2f} | "
+    for n_jobs, backend, label in SEARCHES:
+        runs = [fresh(SEARCH, n_jobs, backend) for _ in range(repeat)]
+        lines.append(f"| {label} | {median([r[0] for r in runs]):.2f} | "
                      f"{median([r[1] for r in runs]):.2f} |")  # fmt: skip
     return "\n".join(lines)
 
@@ -180,9 +191,9 @@ def probe_search(repeat: int) -> str:
 def probe_long_search(repeat: int, dataset: str, data_dir: str) -> str:
     header = f"| GridSearchCV on {dataset}, 5 candidates x 3 folds | search (s) |"
     lines = [header, "| --- | --- |"]
-    for n_jobs in ("1", "2"):
-        runs = [fresh(LONG_SEARCH, n_jobs, dataset, data_dir) for _ in range(repeat)]
-        lines.append(f"| n_jobs={n_jobs} | {median(runs):.2f} |")
+    for n_jobs, backend, label in SEARCHES:
+        runs = [fresh(LONG_SEARCH, n_jobs, dataset, data_dir, backend) for _ in range(repeat)]
+        lines.append(f"| {label} | {median(runs):.2f} |")
     return "\n".join(lines)
 
 

@@ -7,6 +7,10 @@ package, so concurrent calls from threads (joblib's threading backend, dask thre
 for each other instead. The threading layer itself is left as the user or numba chose it:
 importing sk_rtw changes no process-wide setting (:mod:`sk_rtw._threads` sets thread
 counts per call and restores them).
+
+Every kernel of the package is compiled with ``nogil=True`` (tests check it): fits in
+several Python threads (a grid search on joblib's threading backend) run their kernels
+side by side rather than in turn.
 """
 
 from __future__ import annotations

@@ -121,6 +121,26 @@ def test_pipeline_gridsearch_clone_pickle_and_cross_validation():
     assert cloned.get_params() == fitted.get_params() and not hasattr(cloned, "means_")
 
 
+
+def test_a_grid_search_on_threads_scores_as_one_on_a_single_thread():
+    """The user guide's advice for short searches: the search's workers as threads. The
+    kernels then run side by side (they release the GIL); every candidate and fold must
+    score exactly as in a sequential search."""
+    from joblib import parallel_config
+
+    X, y = two_shape_classes()
+    grid = {"method": [RTW(n_epochs=15, hidden_size=16), DBA()], "n_centroids": [1, 2]}
+    base = RTWNearestCentroid(random_state=0)
+    # the log-loss reads the distances to the centroids, not only the predicted labels
+    sequential = GridSearchCV(base, grid, cv=3, n_jobs=1, scoring="neg_log_loss").fit(X, y)
+    with parallel_config(backend="threading"):
+        threaded = GridSearchCV(base, grid, cv=3, n_jobs=2, scoring="neg_log_loss").fit(X, y)
+    for key in ("mean_test_score", "split0_test_score", "split1_test_score",
+                "split2_test_score"):  # fmt: skip
+        np.testing.assert_array_equal(threaded.cv_results_[key], sequential.cv_results_[key])
+    np.testing.assert_array_equal(threaded.predict_proba(X), sequential.predict_proba(X))
+
+
 def test_outputs_and_probabilities():
     X, y = two_shape_classes()
     clf = RTWNearestCentroid(method=RTW(n_epochs=15, hidden_size=16), random_state=0).fit(X, y)

@@ -85,6 +85,28 @@ def test_concurrent_launches_on_the_workqueue_layer_do_not_abort():
     assert result.stdout.strip().splitlines()[-1] == "workqueue"
 
 
+def test_every_compiled_kernel_releases_the_gil():
+    """Threads (joblib's threading backend, a grid search on threads, dask threads) run
+    this package's kernels side by side only if none holds the GIL."""
+    import importlib
+    import pkgutil
+
+    from numba.core.dispatcher import Dispatcher
+
+    import sk_rtw
+
+    kernels = {}
+    for info in pkgutil.walk_packages(sk_rtw.__path__, "sk_rtw."):
+        module = importlib.import_module(info.name)
+        for name, value in vars(module).items():
+            if isinstance(value, Dispatcher) and value.py_func.__module__ == info.name:
+                kernels[f"{info.name}.{name}"] = value
+    assert len(kernels) >= 40  # the DTW, band, medoid, baseline, soft-DTW and sinc kernels
+    holding = sorted(name for name, kernel in kernels.items()
+                     if not kernel.targetoptions.get("nogil"))  # fmt: skip
+    assert not holding, f"kernels compiled without nogil=True: {holding}"
+
+
 def test_a_layer_chosen_by_the_user_is_kept():
     result = run_python(
         """

@@ -66,8 +66,10 @@ def _window_sums(values, rows, base, frac, lengths, window, u, du):  # pragma: n
 #: Serial and multi-threaded builds of the same kernel. Threads pay off only for large
 #: problems: otherwise they compete with torch's own thread pool during the epoch.
 #: IEEE division (``error_model="numpy"``): no zero check per tap.
-window_sums_serial = njit(cache=True, error_model="numpy")(_window_sums)
-window_sums_parallel = njit(cache=True, error_model="numpy", parallel=True)(_window_sums)
+#: ``nogil``: threads (a grid search on joblib's threading backend) run it side by side.
+_OPTIONS = {"cache": True, "nogil": True, "error_model": "numpy"}
+window_sums_serial = njit(**_OPTIONS)(_window_sums)
+window_sums_parallel = njit(**_OPTIONS, parallel=True)(_window_sums)
 #: Taps (N Z K) from which the multi-threaded build is used.
 PARALLEL_TAPS = 2_000_000
 

@@ -13,7 +13,7 @@ import numpy as np
 from numba import njit
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _strides(shape):
     n = shape.size
     strides = np.empty(n, dtype=np.int64)
@@ -24,7 +24,7 @@ def _strides(shape):
     return strides
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _step_offsets(strides):
     """Flat offset of the predecessor reached by stepping back along the axes in ``mask``."""
     n = strides.size
@@ -36,7 +36,7 @@ def _step_offsets(strides):
     return offsets
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _step_order(n):
     """Step masks by decreasing number of axes (diagonal first), then increasing mask."""
     order = np.empty((1 << n) - 1, dtype=np.int64)
@@ -52,7 +52,7 @@ def _step_order(n):
     return order
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def accumulate(pair_costs, pairs, shape, window, D):
     """Fill the flat accumulated cost ``D`` (size ``prod(shape)``) in place.
 
@@ -102,7 +102,7 @@ def accumulate(pair_costs, pairs, shape, window, D):
             k -= 1
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def backtrack(D, shape):
     """Optimal path ``(L, N)`` from the first to the last cell of a filled grid.
 

@@ -37,7 +37,7 @@ RADIUS = 16
 GUIDE_SLACK = 1e-9
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def band_from_path(path, nx, ny, radius):
     """Rows ``[lo, hi)`` covering the cells of a path of the half-length problem, dilated."""
     lo = np.full(nx, ny, dtype=np.int64)
@@ -63,7 +63,7 @@ def band_from_path(path, nx, ny, radius):
     return lo, hi
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def band_segment_costs(x, y, lo, hi, segments, squared, width):
     """Point costs of the band cells for manifolds with kernel distances (segments)."""
     nx = x.shape[0]
@@ -73,7 +73,7 @@ def band_segment_costs(x, y, lo, hi, segments, squared, width):
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def band_accumulate(cost, lo, hi):
     """Accumulated DTW cost of the band cells (``inf`` outside the band)."""
     nx, width = cost.shape
@@ -96,14 +96,14 @@ def band_accumulate(cost, lo, hi):
     return D
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _band_value(D, lo, hi, i, j):
     if j < lo[i] or j >= hi[i]:
         return _INF
     return D[i, j - lo[i]]
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def band_backtrack(D, lo, hi):
     """Optimal path ``(P, 2)`` through a band (ties as the dense recursion breaks them)."""
     nx = D.shape[0]

@@ -43,7 +43,7 @@ def segment_codes(manifold: Manifold) -> np.ndarray | None:
     return np.array([(a, b, SEGMENT_CODES[kind]) for a, b, kind in segments], dtype=np.int64)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def sakoe_chiba_rows(nx: int, ny: int, window: float):
     """Allowed column range ``[lo[i], hi[i])`` of each row of an ``nx x ny`` DTW matrix.
 
@@ -89,7 +89,7 @@ def sakoe_chiba_rows(nx: int, ny: int, window: float):
     return lo, hi
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _accumulate_row(cost_row, prev, cur, i, lo, hi, ny):
     """Fill row ``i`` of the accumulated cost from row ``i - 1``.
 
@@ -105,7 +105,7 @@ def _accumulate_row(cost_row, prev, cur, i, lo, hi, ny):
         cur[j] = _INF
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _band_row(cost_row, prev, cur, lo, hi):
     """:func:`_accumulate_row` for two rows that are reused: only the band is written.
 
@@ -121,7 +121,7 @@ def _band_row(cost_row, prev, cur, lo, hi):
         cur[j + 1] = left
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _cell(prev, left, j, cost):
     """The recursion at column ``j``: ``cost`` plus the least of the cells above-left
     (``prev[j]``), above (``prev[j + 1]``) and left, in padded rows."""
@@ -133,13 +133,13 @@ def _cell(prev, left, j, cost):
     return cost + best
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _two_rows(ny):
     """The buffers of :func:`_band_row`: the row "before" row 0 and an ``inf`` row."""
     return _first_prev(ny), np.full(ny + 1, _INF)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _first_prev(ny):
     """The row "before" row 0: zero at the sentinel, ``inf`` elsewhere."""
     prev = np.full(ny + 1, _INF)
@@ -147,7 +147,7 @@ def _first_prev(ny):
     return prev
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def accumulated_cost(cost: np.ndarray, window: float) -> np.ndarray:
     """Full accumulated cost matrix ``D`` (``inf`` outside the band)."""
     nx, ny = cost.shape
@@ -160,7 +160,7 @@ def accumulated_cost(cost: np.ndarray, window: float) -> np.ndarray:
     return D[:, 1:].copy()
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def final_cost(cost: np.ndarray, nx: int, ny: int, window: float) -> float:
     """DTW distance over the top-left ``nx x ny`` block of ``cost`` (two rows of memory)."""
     lo, hi = sakoe_chiba_rows(nx, ny, window)
@@ -171,7 +171,7 @@ def final_cost(cost: np.ndarray, nx: int, ny: int, window: float) -> float:
     return prev[ny]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _step_back(D, i, j):
     """One step back along the optimal path (ties: diagonal, then up, then left)."""
     if i == 0:
@@ -181,7 +181,7 @@ def _step_back(D, i, j):
     return choose_step(i, j, D[i - 1, j - 1], D[i - 1, j], D[i, j - 1])
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def choose_step(i, j, diag, up, left):
     """The cell before ``(i, j)``, both positive, from its three neighbours' accumulated
     costs: the cheapest, ties broken diagonal, then up, then left (every backtracking of
@@ -193,7 +193,7 @@ def choose_step(i, j, diag, up, left):
     return i, j - 1
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def path_length(D: np.ndarray) -> int:
     """Number of steps of the optimal path encoded in an accumulated cost matrix."""
     i, j = D.shape[0] - 1, D.shape[1] - 1
@@ -204,7 +204,7 @@ def path_length(D: np.ndarray) -> int:
     return steps
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, nogil=True, parallel=True)
 def final_cost_batch(costs, nxs, nys, window, per_step):
     """:func:`final_cost` for a stack of cost matrices, in parallel.
 
@@ -221,7 +221,7 @@ def final_cost_batch(costs, nxs, nys, window, per_step):
     return values
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def backtrack(D: np.ndarray):
     """Optimal warping path (list of index pairs) from an accumulated cost matrix."""
     i, j = D.shape[0] - 1, D.shape[1] - 1
@@ -233,7 +233,7 @@ def backtrack(D: np.ndarray):
     return path
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _accumulate_scaled(value, scale, ssq):
     """One step of the overflow-free sum of squares ``scale^2 ssq`` (as LAPACK's nrm2)."""
     magnitude = abs(value)
@@ -246,7 +246,7 @@ def _accumulate_scaled(value, scale, ssq):
     return scale, ssq
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _robust_distance(xi, yj, segments):
     """``sqrt(sum_s d_s^2)`` without overflow or underflow (for extreme magnitudes)."""
     scale, ssq = 0.0, 1.0
@@ -276,7 +276,7 @@ def _robust_distance(xi, yj, segments):
 _TINY, _HUGE = 1e-290, 1e290
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _cost_row(x, y, i, ny, segments, squared, row):
     """Row ``i`` of the cost matrix: point costs between ``x[i]`` and ``y[:ny]``."""
     xi = x[i]
@@ -320,14 +320,14 @@ def _cost_row(x, y, i, ny, segments, squared, row):
                 row[j] = math.sqrt(sq)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def segment_cost_matrix(x, y, nx, ny, segments, squared, out):
     """Cost matrix of flattened series ``x`` (Tx, p) and ``y`` (Ty, p) into ``out``."""
     for i in range(nx):
         _cost_row(x, y, i, ny, segments, squared, out[i])
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def path_cost(x, y, path, segments, squared):
     """The cost of a warping path ``(P, 2)`` between flattened series, summed along it
     in order: the value the DTW recursion gives that path, bit for bit (the same point
@@ -346,7 +346,7 @@ def path_cost(x, y, path, segments, squared):
 PRUNE_CHUNK = 32
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _pruned_row(x, y, i, prev, cur, costs, lo, hi, reach, bound, segments, squared):
     """Row ``i`` of the accumulated cost into ``cur`` (padded as in :func:`_accumulate_row`)
     from column ``lo`` on, skipping what cannot beat ``bound`` (PrunedDTW: Silva and
@@ -379,7 +379,7 @@ def _pruned_row(x, y, i, prev, cur, costs, lo, hi, reach, bound, segments, squar
     return first, last, hi - 1
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def accumulated_segment_cost(x, y, segments, squared, window, bound):
     """The accumulated cost of flattened series ``x`` and ``y`` where a path of cost at
     most ``bound`` can pass, stored row by row (:func:`_pruned_row`; ``inf``: every cell
@@ -400,7 +400,7 @@ def accumulated_segment_cost(x, y, segments, squared, window, bound):
     return _pruned_rows(x, y, segments, squared, window, bound, True)[:3]
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def pruned_distance(x, y, segments, squared, window, bound):
     """The DTW distance of flattened series ``x`` and ``y`` in two rows of memory, the
     cells that cannot beat ``bound`` skipped as in :func:`accumulated_segment_cost`:
@@ -419,7 +419,7 @@ def pruned_distance(x, y, segments, squared, window, bound):
     return _pruned_rows(x, y, segments, squared, window, bound, False)[3]
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _pruned_rows(x, y, segments, squared, window, bound, store):
     """Rows of the accumulated cost in two buffers, each kept in ``values`` if ``store``:
     ``(values, offsets, starts, last cell)`` (see :func:`accumulated_segment_cost`)."""
@@ -460,7 +460,7 @@ def _pruned_rows(x, y, segments, squared, window, bound, store):
     return values[: offsets[rows]], offsets, starts, prev[ny]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def ragged_value(values, offsets, starts, i, j):
     """Cell ``(i, j)`` of :func:`accumulated_segment_cost`'s rows (``inf`` if not stored)."""
     k = j - starts[i]
@@ -469,7 +469,7 @@ def ragged_value(values, offsets, starts, i, j):
     return values[offsets[i] + k]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _ragged_step(values, offsets, starts, i, j):
     """The cell before ``(i, j)`` on the optimal path through stored rows."""
     if i == 0:
@@ -484,7 +484,7 @@ def _ragged_step(values, offsets, starts, i, j):
     )  # fmt: skip
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def ragged_backtrack(values, offsets, starts, ny):
     """The optimal path ``(P, 2)`` through :func:`accumulated_segment_cost`'s rows, ties
     broken as :func:`backtrack` breaks them."""
@@ -500,7 +500,7 @@ def ragged_backtrack(values, offsets, starts, ny):
     return path[: n + 1][::-1].copy()
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, nogil=True, parallel=True)
 def segment_cost_stack(x, Y, nx, nys, segments, squared):
     """Cost matrices between ``x`` and each series of ``Y``, shape (len(Y), Tx, Ty)."""
     out = np.zeros((Y.shape[0], x.shape[0], Y.shape[1]))
@@ -509,7 +509,7 @@ def segment_cost_stack(x, Y, nx, nys, segments, squared):
     return out
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, nogil=True, parallel=True)
 def pairwise_segments(X, lx, Y, ly, segments, squared, window, symmetric, bounds):
     """DTW between every series of ``X`` and of ``Y``, the cost rows computed in numba.
 
@@ -538,7 +538,7 @@ def pairwise_segments(X, lx, Y, ly, segments, squared, window, symmetric, bounds
     return values
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def matched_positions(references, reference_lengths, X, lengths, codes, segments, squared,
                       window):  # fmt: skip
     """For every series, the mean index of its samples matched with each sample of its

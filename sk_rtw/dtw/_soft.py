@@ -25,7 +25,7 @@ from ._kernels import sakoe_chiba_rows
 _INF = np.inf
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _softmin3(a, b, c, gamma):
     m = min(a, b, c)
     if m == _INF:
@@ -34,7 +34,7 @@ def _softmin3(a, b, c, gamma):
     return m - gamma * math.log(total)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def soft_dtw(cost: np.ndarray, gamma: float, window: float):
     """Value and soft alignment ``E`` (same shape as ``cost``) of one cost matrix."""
     m, n = cost.shape
@@ -73,7 +73,7 @@ def soft_dtw(cost: np.ndarray, gamma: float, window: float):
     return value, E[1 : m + 1, 1 : n + 1].copy()
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, nogil=True, parallel=True)
 def soft_dtw_batch(costs, nxs, nys, gamma, window):
     """:func:`soft_dtw` for a stack of padded cost matrices ``(K, m_max, n_max)``."""
     k_total = costs.shape[0]

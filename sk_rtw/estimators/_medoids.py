@@ -22,7 +22,7 @@ from numba import njit
 MAX_ROUNDS = 100
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _build(D, k):
     n = D.shape[0]
     medoids = np.empty(k, dtype=np.int64)
@@ -51,7 +51,7 @@ def _build(D, k):
     return medoids
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _assign(D, medoids):
     n, k = D.shape[0], medoids.shape[0]
     labels = np.empty(n, dtype=np.int64)
@@ -66,7 +66,7 @@ def _assign(D, medoids):
     return labels
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def kmedoids(D: np.ndarray, k: int):
     """Deterministic k-medoids of the points of a distance matrix (module docstring).
 
@@ -108,7 +108,7 @@ def kmedoids(D: np.ndarray, k: int):
     return medoids, labels
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _submatrix(D, index):
     n = index.shape[0]
     out = np.empty((n, n))
@@ -118,7 +118,7 @@ def _submatrix(D, index):
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def loo_class_distances(D: np.ndarray, codes: np.ndarray, n_classes: int, k: int) -> np.ndarray:
     """Distance of every series to the nearest of ``k`` medoids of every class.
 
