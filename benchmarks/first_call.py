@@ -20,6 +20,10 @@ Every probe runs in fresh interpreters (``sys.executable``), as a user meets the
   ``n_jobs=1``, ``n_jobs=2`` (joblib's default process workers) and ``n_jobs=2`` on
   threads (``joblib.parallel_config(backend="threading")``, which starts nothing), each
   searched twice in the same process: the second search reuses the workers;
+* ``worker``: what a process worker of a parallel search pays before its first candidate:
+  a fresh interpreter imports scikit-learn's model selection (every loky worker does, to
+  run ``_fit_and_score``), then sk_rtw, then fits the default classifier on a GunPoint
+  fold twice (the first fit against the second is the one-time cost of the fit);
 * ``long-search``: the default classifier searched over RTW's ``hidden_size`` x
   ``learning_rate`` and DBA (5 candidates x 3 folds) on ``--dataset`` from ``--data-dir``
   (the development archive's Plane by default), the same three ways.
@@ -111,6 +115,29 @@ print(json.dumps(times))
 """
 
 
+WORKER = """
+import json, time
+t = time.perf_counter()
+import sklearn.model_selection._validation
+t_sklearn = time.perf_counter() - t
+t = time.perf_counter()
+import sk_rtw
+t_sk_rtw = time.perf_counter() - t
+from aeon.datasets import load_classification
+from sk_rtw import RTW, RTWNearestCentroid
+X, y = load_classification("GunPoint", split="train")
+X = X[:34, 0, :]
+fits = []
+for _ in range(2):
+    t = time.perf_counter()
+    RTWNearestCentroid(method=RTW(hidden_size=16), n_centroids=1, dtw_window=None,
+                       random_state=0).fit(X, y[:34])
+    fits.append(time.perf_counter() - t)
+print(json.dumps({"sklearn": t_sklearn, "sk_rtw": t_sk_rtw, "first": fits[0],
+                  "second": fits[1]}))
+"""
+
+
 LONG_SEARCH = """
 import json, sys, time
 from aeon.datasets import load_classification
@@ -188,6 +215,15 @@ def probe_search(repeat: int) -> str:
     return "\n".join(lines)
 
 
+def probe_worker(repeat: int) -> str:
+    runs = [fresh(WORKER) for _ in range(repeat)]
+    cells = [median([r[key] for r in runs]) for key in ("sklearn", "sk_rtw", "first", "second")]
+    return (
+        "| import sklearn.model_selection | then import sk_rtw | first fit | second fit |\n"
+        "| --- | --- | --- | --- |\n| " + " | ".join(f"{c:.2f} s" for c in cells) + " |"
+    )
+
+
 def probe_long_search(repeat: int, dataset: str, data_dir: str) -> str:
     header = f"| GridSearchCV on {dataset}, 5 candidates x 3 folds | search (s) |"
     lines = [header, "| --- | --- |"]
@@ -198,7 +234,7 @@ def probe_long_search(repeat: int, dataset: str, data_dir: str) -> str:
 
 
 PROBES = {"align": probe_align, "split": probe_split, "search": probe_search,
-          "long-search": probe_long_search}  # fmt: skip
+          "worker": probe_worker, "long-search": probe_long_search}  # fmt: skip
 
 
 def main(argv=None) -> None:
