@@ -137,11 +137,13 @@ class Trainer:
             significant = (value < threshold) | torch.isinf(self.best_loss)
             self.best_loss.copy_(torch.where(better, value, self.best_loss))
             self.best_epoch.copy_(torch.where(better, self.epoch, self.best_epoch))
-            # on a CPU reading the flags is free: copy only when a group improved
+            # on a CPU reading the flags is free: copy only when a group improved, and
+            # plainly when every group did (one group: each improving epoch)
             if self.cuda or bool(better.any()):
+                every = not self.cuda and bool(better.all())
                 for kept, current, shape in zip(self.best, self.parameters, self._shapes,
                                                 strict=True):  # fmt: skip
-                    kept.copy_(torch.where(better[shape], current, kept))
+                    kept.copy_(current if every else torch.where(better[shape], current, kept))
             self.history.index_copy_(
                 0, self.epoch, torch.where(active, value, math.nan).unsqueeze(0)
             )
