@@ -13,6 +13,11 @@ group follows exactly the trajectory of a separate fit. Per group the loop keeps
   row the group stops: its best iterate is frozen. The loop ends when every group has
   stopped or after ``n_epochs``.
 
+A caller may pause the loop (``run(pause=...)``) and continue with the running groups
+only (:meth:`Trainer.narrow`): best iterates, counters, history and Adam's moments are
+carried over, so each group's trajectory is the one it had in the whole batch (the engine
+narrows its batch once half of the groups have stopped).
+
 All bookkeeping is tensor operations (``torch.where``), so an epoch needs no host-device
 synchronisation on a GPU; on a CPU the stop flags are read every epoch, on CUDA every
 ``report_every`` epochs.
