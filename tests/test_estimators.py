@@ -126,6 +126,8 @@ def test_a_grid_search_on_threads_scores_as_one_on_a_single_thread():
     """The user guide's advice for short searches: the search's workers as threads. The
     kernels then run side by side (they release the GIL); every candidate and fold must
     score exactly as in a sequential search."""
+    import numba
+    import torch
     from joblib import parallel_config
 
     X, y = two_shape_classes()
@@ -133,8 +135,11 @@ def test_a_grid_search_on_threads_scores_as_one_on_a_single_thread():
     base = RTWNearestCentroid(random_state=0)
     # the log-loss reads the distances to the centroids, not only the predicted labels
     sequential = GridSearchCV(base, grid, cv=3, n_jobs=1, scoring="neg_log_loss").fit(X, y)
+    threads_before = (torch.get_num_threads(), numba.get_num_threads())
     with parallel_config(backend="threading"):
         threaded = GridSearchCV(base, grid, cv=3, n_jobs=2, scoring="neg_log_loss").fit(X, y)
+    # the fits set their thread counts in their own threads: the caller's are untouched
+    assert (torch.get_num_threads(), numba.get_num_threads()) == threads_before
     for key in ("mean_test_score", "split0_test_score", "split1_test_score",
                 "split2_test_score"):  # fmt: skip
         np.testing.assert_array_equal(threaded.cv_results_[key], sequential.cv_results_[key])
