@@ -612,7 +612,7 @@ def _optimise(
     config = problem.config
     n_groups = problem.layout.n_groups
     trainer = Trainer(
-        lambda: problem.forward(model)[:2],
+        partial(_stage_loss, problem, model),
         list(model.parameters()),
         config.n_epochs,
         config.learning_rate,
@@ -640,11 +640,12 @@ def _optimise(
         best_epoch[ids] = trainer.best_epoch.cpu().numpy()
         epochs_run[ids] = trainer.epochs_run.cpu().numpy()
         if best is not None:  # finished: the stage model holds every group's best iterate
-            _write_back(model, stage_model, running)
+            if stage_model is not model:
+                _write_back(model, running, list(stage_model.parameters()))
             break
         # the stopped groups' best iterates go back to the whole model; the rest go on alone
         stopped = torch.nonzero(~trainer.active.cpu()).flatten()
-        _write_back(model, stage_model, running[stopped], trainer.best, trainer.rows(stopped))
+        _write_back(model, running[stopped], trainer.best, trainer.rows(stopped))
         keep = torch.nonzero(trainer.active.cpu()).flatten()
         stage_problem = stage_problem.subset(keep.to(stage_problem.layout.codes.device))
         stage_model = stage_model.subset(keep.to(trainer.device))
@@ -671,18 +672,21 @@ def _half_stopped(active: torch.Tensor) -> bool:
 
 
 def _stage_loss(problem: _Problem, model: WarpModel):
+    """The trainer's loss: total and per-group losses of ``model`` on ``problem``."""
     return problem.forward(model)[:2]
 
 
-def _write_back(whole: WarpModel, stage: WarpModel, groups: torch.Tensor, values=None,
-                rows=None) -> None:  # fmt: skip
-    """Copy the parameters of ``groups`` (the whole model's numbering) from a narrowed
-    ``stage`` model (or from ``values`` at ``rows`` of its parameters) into ``whole``."""
-    if values is None:
-        values = list(stage.parameters())
-        rows = [torch.arange(v.shape[0], device=v.device) for v in values]
+def _write_back(
+    whole: WarpModel,
+    groups: torch.Tensor,
+    values: list[torch.Tensor],
+    rows: list[torch.Tensor] | None = None,
+) -> None:
+    """Copy a narrowed model's parameter ``values`` (or their ``rows``) for ``groups``
+    (the whole model's numbering) into ``whole``'s parameters."""
     groups = groups.to(next(whole.parameters()).device)
+    picks: list[torch.Tensor | None] = list(rows) if rows is not None else [None] * len(values)
     with torch.no_grad():
         for target, owner, value, picked in zip(whole.parameters(), whole.parameter_groups(),
-                                                values, rows, strict=True):  # fmt: skip
-            target[torch.isin(owner, groups)] = value[picked]
+                                                values, picks, strict=True):  # fmt: skip
+            target[torch.isin(owner, groups)] = value if picked is None else value[picked]
