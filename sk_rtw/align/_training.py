@@ -47,6 +47,14 @@ from ._adam import FusedAdam
 WARMUP_EPOCHS = 3
 
 
+def _group_shapes(parameter_groups, parameters, device) -> list[torch.Tensor]:
+    """Every parameter's group labels shaped to broadcast over the parameter."""
+    return [
+        groups.to(device).view(-1, *([1] * max(p.ndim - 1, 0)))
+        for groups, p in zip(parameter_groups, parameters, strict=True)
+    ]
+
+
 class Trainer:
     """Adam on ``parameters`` minimising ``loss_fn()``; keeps every group's best parameters.
 
@@ -101,10 +109,7 @@ class Trainer:
         if parameter_groups is None:
             parameter_groups = [torch.zeros(p.shape[0] if p.ndim else 1, dtype=torch.long)
                                 for p in parameters]  # fmt: skip
-        self._shapes = [
-            groups.to(device).view(-1, *([1] * max(p.ndim - 1, 0)))
-            for groups, p in zip(parameter_groups, parameters, strict=True)
-        ]
+        self._shapes = _group_shapes(parameter_groups, parameters, device)
         #: Which group each of this trainer's groups is in the caller's numbering (error
         #: messages of a narrowed trainer name the caller's groups).
         self.group_ids = np.arange(n_groups)
@@ -230,10 +235,7 @@ class Trainer:
         other.parameters = list(parameters)
         other.n_groups = len(groups)
         other.group_ids = self.group_ids[groups.cpu().numpy()]
-        other._shapes = [
-            g.to(self.device).view(-1, *([1] * max(p.ndim - 1, 0)))
-            for g, p in zip(parameter_groups, parameters, strict=True)
-        ]
+        other._shapes = _group_shapes(parameter_groups, other.parameters, self.device)
         other.optimiser = self.optimiser.narrow(other.parameters, rows)
         other.best = [kept[r].clone() for kept, r in zip(self.best, rows, strict=True)]
         for name in ("best_loss", "best_epoch", "active", "stalled", "epochs_run"):
