@@ -140,10 +140,10 @@ class _Problem:
         layout, rows = self.layout.subset(groups)
         other = copy.copy(self)
         other.layout = layout
-        other.data = self.data[rows]
-        other.lengths = self.lengths[rows]
-        other.series_weight = self.series_weight[rows]
         other.interpolate = self.interpolate.subset(rows)
+        # one copy of the series, shared with the interpolator as in the whole problem
+        other.data, other.lengths = other.interpolate.data, other.interpolate.lengths
+        other.series_weight = self.series_weight[rows]
         other.start = None if self.start is None else self.start[rows]
         other.warm = None if self.warm is None else self.warm[groups].clone()
         return other
