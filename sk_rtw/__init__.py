@@ -5,7 +5,13 @@ Align, average and classify time series whose samples live on Riemannian manifol
 
 from . import baselines, datasets, methods, metrics, statistics
 from .align import Alignment, align
-from .dtw import dtw_cost_matrix, dtw_distance, dtw_pairwise_distance, dtw_path
+from .dtw import (
+    dtw_cost_matrix,
+    dtw_distance,
+    dtw_nearest_distance,
+    dtw_pairwise_distance,
+    dtw_path,
+)
 from .estimators import (
     NTWAverager,
     NTWNearestCentroid,
@@ -61,6 +67,7 @@ __all__ = [
     "datasets",
     "dtw_cost_matrix",
     "dtw_distance",
+    "dtw_nearest_distance",
     "dtw_pairwise_distance",
     "dtw_path",
     "get_manifold",

@@ -1,0 +1,349 @@
+"""Nearest references by DTW, with lower bounds and early abandoning.
+
+A nearest-centroid classifier with many centroids, 1-NN DTW, and the leave-one-out
+scores of the ``"auto"`` choice all ask the same question: for every query series, the
+DTW distance to the nearest reference of every class. The exhaustive answer computes
+every pair; :func:`nearest_by_class` computes the same values with far fewer cells
+(Keogh and Ratanamahatana 2005; Rakthanmanon et al. 2012, the "UCR suite"):
+
+1. **LB_Keogh** of every pair: the envelope of the query over the Sakoe-Chiba band (for
+   every column ``j`` of the reference, the coordinate-wise least and greatest value of
+   the query samples that may be matched with it), and the distance of every reference
+   sample to that envelope. Every column is on the warping path, and a point's cost to
+   any query sample of its band is at least its distance to the envelope, so the sum
+   bounds DTW from below. On a sphere the bound on the chord is turned into one on the
+   angle (``2 asin(c / 2)``, increasing); on quaternions the smaller of the bounds of
+   ``q`` and ``-q`` is taken; product spaces combine their factors' bounds as their
+   distances are combined.
+2. References are visited in increasing order of their bound; one whose bound exceeds
+   the best distance found so far for its class is skipped, and the search stops once
+   no bound left can beat any class. When only the nearest class is wanted (an argmin:
+   ``predict``; whether another class is nearer than a series' own), the best distance
+   over all classes is the threshold, and far classes are never searched to their end.
+3. **Early abandoning**: the DTW of a visited reference is computed with that threshold
+   as a bound (:func:`~sk_rtw.dtw._kernels.pruned_distance`, PrunedDTW): cells that
+   cannot beat it are skipped, and the pair stops as soon as no path can.
+
+The distances returned are those of the exhaustive search bit for bit: a reference that
+is skipped cannot be nearer than the best so far (nor tie with it), and a distance that
+is computed is the plain recursion's value whenever it can matter. A relative slack of
+:data:`LB_SLACK` keeps a rounding difference between the bound and the distance from
+skipping a tie.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from numba import njit, prange
+
+from .._numba import numba_threads
+from ..manifolds import Manifold
+from ..utils import SeriesCollection, check_series_collection
+from . import _kernels
+from ._dtw import check_window, dtw_pairwise_distance
+
+_INF = np.inf
+
+#: A reference is skipped when its bound exceeds the best distance so far by this
+#: relative margin or more (the bound and the distance are rounded differently).
+LB_SLACK = 1e-12
+
+
+@njit(cache=True, nogil=True)
+def query_envelope(x, ny, window, lower, upper):
+    """The envelope of query ``x`` (``(T_x, p)``) seen from a reference of ``ny`` samples.
+
+    Column ``j`` of an ``T_x x ny`` DTW matrix may be matched with the query rows ``i``
+    whose Sakoe-Chiba range holds ``j`` (:func:`~sk_rtw.dtw._kernels.sakoe_chiba_rows`):
+    a contiguous run ``[a_j, b_j]`` whose ends never decrease with ``j``. ``lower[j]`` and
+    ``upper[j]`` (each ``(p,)``) receive the coordinate-wise least and greatest query
+    value over that run (a monotone-deque sliding minimum and maximum, ``O(T_x + ny)``
+    per coordinate).
+    """
+    nx, p = x.shape
+    lo, hi = _kernels.sakoe_chiba_rows(nx, ny, window)
+    first = np.empty(ny, dtype=np.int64)  # a_j: the first row whose range reaches j
+    last = np.empty(ny, dtype=np.int64)  # b_j: the last row whose range starts at or before j
+    i = 0
+    for j in range(ny):
+        while hi[i] <= j:
+            i += 1
+        first[j] = i
+    i = nx - 1
+    for j in range(ny - 1, -1, -1):
+        while lo[i] > j:
+            i -= 1
+        last[j] = i
+    low_queue = np.empty(nx, dtype=np.int64)
+    high_queue = np.empty(nx, dtype=np.int64)
+    for k in range(p):
+        low_head, low_tail, high_head, high_tail = 0, 0, 0, 0
+        pushed = 0  # rows [0, pushed) have entered the queues
+        for j in range(ny):
+            while pushed <= last[j]:
+                value = x[pushed, k]
+                while low_tail > low_head and x[low_queue[low_tail - 1], k] >= value:
+                    low_tail -= 1
+                low_queue[low_tail] = pushed
+                low_tail += 1
+                while high_tail > high_head and x[high_queue[high_tail - 1], k] <= value:
+                    high_tail -= 1
+                high_queue[high_tail] = pushed
+                high_tail += 1
+                pushed += 1
+            while low_queue[low_head] < first[j]:
+                low_head += 1
+            while high_queue[high_head] < first[j]:
+                high_head += 1
+            lower[j, k] = x[low_queue[low_head], k]
+            upper[j, k] = x[high_queue[high_head], k]
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _outside(value, low, high):
+    """Distance of ``value`` to the interval ``[low, high]``."""
+    if value > high:
+        return value - high
+    if value < low:
+        return low - value
+    return 0.0
+
+
+@njit(cache=True, nogil=True)
+def lb_keogh(y, lower, upper, segments, squared):
+    """LB_Keogh of reference ``y`` (``(T_y, p)``) against a query's envelope
+    (:func:`query_envelope`), in the point cost of ``segments`` (module docstring)."""
+    ny = y.shape[0]
+    total = 0.0
+    n_segments = segments.shape[0]
+    univariate = n_segments == 1 and segments[0, 2] == _kernels.SEGMENT_EUCLIDEAN and (
+        segments[0, 1] == 1
+    )
+    for j in range(ny):
+        if univariate:
+            gap = _outside(y[j, 0], lower[j, 0], upper[j, 0])
+            total += gap * gap if squared else gap
+        else:
+            sq = 0.0
+            for s in range(n_segments):
+                start, stop, code = segments[s, 0], segments[s, 1], segments[s, 2]
+                near = 0.0
+                for k in range(start, stop):
+                    gap = _outside(y[j, k], lower[j, k], upper[j, k])
+                    near += gap * gap
+                if code == _kernels.SEGMENT_EUCLIDEAN:
+                    sq += near
+                    continue
+                if code == _kernels.SEGMENT_SIGN_INVARIANT_SPHERE:
+                    flipped = 0.0  # the envelope of -x is [-upper, -lower]
+                    for k in range(start, stop):
+                        gap = _outside(y[j, k], -upper[j, k], -lower[j, k])
+                        flipped += gap * gap
+                    near = min(near, flipped)
+                angle = 2.0 * math.asin(min(1.0, 0.5 * math.sqrt(near)))
+                sq += angle * angle
+            total += sq if squared else math.sqrt(sq)
+    return total
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def nearest_by_class(
+    Q, lq, R, lr, owners, n_classes, skip_reference, skip_class, limits, every_class,
+    segments, squared, window,
+):  # fmt: skip
+    """DTW distance of every query to the nearest reference of every class (module
+    docstring), the values of the exhaustive search.
+
+    ``Q`` ``(n_q, T, p)`` with lengths ``lq``; references ``R`` ``(n_r, L, p)`` with lengths
+    ``lr`` and classes ``owners`` (``0..n_classes - 1``). Query ``q`` ignores reference
+    ``skip_reference[q]`` and the references of class ``skip_class[q]`` (-1: none), and
+    distances above ``limits[q]``. With ``every_class`` every class's nearest distance is
+    computed; otherwise only the nearest class's (and those tied with it), the others
+    left ``inf``. Returns the distances ``(n_q, n_classes)`` (``inf`` where none was
+    wanted or left) and the number of exact DTWs computed per query.
+    """
+    n_q, n_r, p = Q.shape[0], R.shape[0], Q.shape[2]
+    out = np.full((n_q, n_classes), _INF)
+    computed = np.zeros(n_q, dtype=np.int64)
+    by_length = np.argsort(lr, kind="mergesort")  # envelopes computed once per length
+    for q in prange(n_q):
+        x = Q[q, : lq[q]]
+        lower = np.empty((R.shape[1], p))
+        upper = np.empty((R.shape[1], p))
+        candidates = np.empty(n_r, dtype=np.int64)
+        bounds = np.empty(n_r)
+        available = np.zeros(n_classes, dtype=np.bool_)
+        n = 0
+        current = -1
+        for r in by_length:
+            if r == skip_reference[q] or owners[r] == skip_class[q]:
+                continue
+            if lr[r] != current:
+                current = lr[r]
+                query_envelope(x, current, window, lower, upper)
+            candidates[n] = r
+            bounds[n] = lb_keogh(R[r, : lr[r]], lower, upper, segments, squared)
+            available[owners[r]] = True
+            n += 1
+        best = out[q]
+        nearest = limits[q]  # the least distance found (or the limit)
+        worst = limits[q] if every_class else nearest  # no class can improve above it
+        for position in np.argsort(bounds[:n], kind="mergesort"):
+            bound = bounds[position] * (1.0 - LB_SLACK)
+            if bound > worst:
+                break
+            r = candidates[position]
+            c = owners[r]
+            threshold = min(best[c], limits[q]) if every_class else nearest
+            if bound > threshold:
+                continue
+            value = _kernels.pruned_distance(x, R[r, : lr[r]], segments, squared, window,
+                                             threshold)  # fmt: skip
+            computed[q] += 1
+            if value <= threshold and value < best[c]:
+                best[c] = value
+                nearest = min(nearest, value)
+                if every_class:
+                    worst = 0.0
+                    for k in range(n_classes):
+                        if available[k] and best[k] > worst:
+                            worst = best[k]
+                    worst = min(worst, limits[q])
+                else:
+                    worst = nearest
+        if not every_class:
+            for k in range(n_classes):
+                if best[k] > nearest:
+                    best[k] = _INF
+    return out, computed
+
+
+def dtw_nearest_distance(
+    X: Any,
+    Y: Any,
+    groups: Any = None,
+    manifold: str | Manifold = "euclidean",
+    window: float | None = None,
+    squared: bool = False,
+    exclude: Any = None,
+    exclude_group: Any = None,
+    max_distance: Any = None,
+    nearest_only: bool = False,
+    n_jobs: int | None = None,
+) -> np.ndarray:
+    """DTW distance from every series of ``X`` to the nearest series of ``Y`` in every
+    group: ``dtw_pairwise_distance(X, Y)`` reduced by group, without computing every pair.
+
+    Lower bounds (LB_Keogh) skip the series of ``Y`` that cannot be nearer than the
+    best distance so far, and the exact DTWs stop early once they cannot (module
+    docstring of :mod:`sk_rtw.dtw._search`); the values are those of the exhaustive
+    search, bit for bit. Manifolds whose point distances have no compiled form (SPD,
+    yours) take the exhaustive search.
+
+    Parameters
+    ----------
+    X : array-like or list of array-like
+        The query series: ``(n, T)``, ``(n, T, *point_shape)`` or a list.
+    Y : same forms as ``X``
+        The reference series.
+    groups : array-like of int, shape (n_Y,), optional
+        Group of every series of ``Y``, ``0..n_groups - 1`` (a class, or the class of a
+        centroid); default: one group (the nearest series overall).
+    manifold, window, squared
+        As in :func:`~sk_rtw.dtw.dtw_distance`.
+    exclude : array-like of int, shape (n_X,), optional
+        For every series of ``X``, a series of ``Y`` it is not compared with (-1: none):
+        ``np.arange(n)`` with ``Y`` = ``X`` gives leave-one-out nearest neighbours.
+    exclude_group : array-like of int, shape (n_X,), optional
+        For every series of ``X``, a group it is not compared with (-1: none); its column
+        is ``inf``.
+    max_distance : float or array-like of shape (n_X,), optional
+        Distances above it (per series of ``X``) are not wanted: they are skipped early
+        and reported as ``inf``.
+    nearest_only : bool, default=False
+        Only the nearest group of every series is wanted (its distance, and any group
+        tied with it; ``inf`` elsewhere): all that ``argmin`` needs, and far cheaper
+        when the groups are well apart, since no group but the nearest must be searched
+        to its end.
+    n_jobs : int, optional
+        Threads over the series of ``X`` (numba); ``-1`` uses all cores. Default: 1.
+
+    Returns
+    -------
+    distances : ndarray of shape (n_X, n_groups)
+        ``inf`` where a group has no series left to compare with (or none was wanted).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> X = np.array([[0.0, 1.0, 2.0], [5.0, 5.0, 5.0]])
+    >>> Y = np.array([[0.0, 1.0, 1.0, 2.0], [9.0, 9.0, 9.0, 9.0], [5.0, 5.0, 6.0, 5.0]])
+    >>> dtw_nearest_distance(X, Y, groups=[0, 1, 1])
+    array([[ 0., 16.],
+           [16.,  1.]])
+    """
+    return _nearest(X, Y, groups, manifold, window, squared, exclude, exclude_group,
+                    max_distance, nearest_only, n_jobs)[0]  # fmt: skip
+
+
+def _nearest(X, Y, groups, manifold, window, squared, exclude, exclude_group, max_distance,
+             nearest_only, n_jobs):  # fmt: skip
+    """:func:`dtw_nearest_distance` and the number of exact DTWs it computed per series
+    of ``X`` (every pair's count for the exhaustive search)."""
+    w = check_window(window)
+    cx = X if isinstance(X, SeriesCollection) else check_series_collection(
+        X, manifold, name="X", min_length=1
+    )
+    cy = Y if isinstance(Y, SeriesCollection) else check_series_collection(
+        Y, cx.manifold, name="Y", min_length=1
+    )
+    n, m = cx.n_series, cy.n_series
+    owners = _indices(groups, m, "groups", np.zeros(m, dtype=np.int64), lowest=0)
+    n_groups = int(owners.max()) + 1
+    skip = _indices(exclude, n, "exclude", np.full(n, -1, dtype=np.int64), lowest=-1)
+    skip_group = _indices(exclude_group, n, "exclude_group", np.full(n, -1, dtype=np.int64),
+                          lowest=-1)  # fmt: skip
+    if n and skip.max() >= m:
+        raise ValueError(f"exclude holds {skip.max()}, but Y has {m} series")
+    limits = np.broadcast_to(np.inf if max_distance is None else max_distance, (n,))
+    limits = np.ascontiguousarray(limits, dtype=np.float64)
+    if np.isnan(limits).any():
+        raise ValueError("max_distance must not be NaN")
+    segments = _kernels.segment_codes(cx.manifold)
+    if segments is None:
+        distances = dtw_pairwise_distance(cx, cy, window=window, squared=squared,
+                                          n_jobs=n_jobs)  # fmt: skip
+        rows = np.flatnonzero(skip >= 0)
+        distances[rows, skip[rows]] = np.inf
+        distances[skip_group[:, None] == owners[None, :]] = np.inf
+        distances[distances > limits[:, None]] = np.inf
+        out = np.full((n, n_groups), np.inf)
+        np.minimum.at(out.T, owners, distances.T)
+        if nearest_only:
+            out[out > out.min(1, keepdims=True)] = np.inf
+        return out, np.full(n, m, dtype=np.int64)
+    with numba_threads(n_jobs):
+        return nearest_by_class(
+            _flat_stack(cx), cx.lengths, _flat_stack(cy), cy.lengths, owners, n_groups, skip,
+            skip_group, limits, not nearest_only, segments, bool(squared), w,
+        )  # fmt: skip
+
+
+def _flat_stack(collection: SeriesCollection) -> np.ndarray:
+    return np.ascontiguousarray(
+        collection.data.reshape(collection.n_series, collection.max_length, -1)
+    )
+
+
+def _indices(values: Any, size: int, name: str, default: np.ndarray, lowest: int) -> np.ndarray:
+    if values is None:
+        return default
+    array = np.asarray(values)
+    if array.shape != (size,) or array.dtype.kind not in "iu":
+        raise ValueError(f"{name} must be {size} integers, one per series; got {array!r:.80}")
+    if size and array.min() < lowest:
+        raise ValueError(f"{name} must hold integers from {lowest} up; got {array.min()}")
+    return np.ascontiguousarray(array, dtype=np.int64)
