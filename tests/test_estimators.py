@@ -415,3 +415,24 @@ def test_bad_temperatures_are_rejected(bad):
     X = np.stack([np.sin(np.linspace(0, 3, 20) + s) for s in (0.0, 0.1, 2.0, 2.1)])
     with pytest.raises(ValueError, match="temperature"):
         RTWNearestCentroid(method="dba", temperature=bad).fit(X, [0, 0, 1, 1])
+
+
+@pytest.mark.parametrize("manifold", ["euclidean", "sphere"])
+def test_many_centroids_predict_as_the_exhaustive_search(manifold):
+    """The nearest centroid of every class is found with lower bounds and early
+    abandoning: the distances of transform reduced per class, and its predictions."""
+    rng = np.random.default_rng(3)
+    X = rng.standard_normal((60, 25, 3 if manifold == "sphere" else 1)).cumsum(1)
+    if manifold == "sphere":
+        X /= np.linalg.norm(X, axis=-1, keepdims=True)
+    y = np.repeat([0, 1, 2], 20)
+    clf = RTWNearestCentroid(manifold, method="dba", n_centroids=0.5, dtw_window=0.1).fit(X, y)
+    assert len(clf.means_) == 30
+    X_new = X[::3] + 0.01 * rng.standard_normal(X[::3].shape)
+    if manifold == "sphere":
+        X_new /= np.linalg.norm(X_new, axis=-1, keepdims=True)
+    every = clf.transform(X_new)
+    by_class = np.stack([every[:, clf.centroid_classes_ == c].min(1) for c in range(3)], 1)
+    np.testing.assert_array_equal(clf.class_distances(X_new), by_class)
+    np.testing.assert_array_equal(clf.predict(X_new), clf.classes_[by_class.argmin(1)])
+    np.testing.assert_allclose(clf.predict_proba(X_new).sum(1), 1.0)

@@ -43,10 +43,10 @@ class RTWAverager(TransformerMixin, BaseEstimator):
     :func:`sk_rtw.align` (RTW, TTW, NTW; every class in one batched optimisation) or with
     manifold DTW barycenter averaging (``method="dba"``) -- and keeps the class means;
     ``transform`` returns the manifold-DTW distance of each series to each mean (like
-    ``KMeans.transform``). With ``n_centroids=k`` every class is split into ``k`` parts by
-    k-medoids on the DTW matrix of its series and every part is averaged, and
-    ``transform`` returns the distance to every centroid: features for a downstream
-    classifier.
+    ``KMeans.transform``). With ``n_centroids=k`` every class is split into ``k`` parts
+    (with a fraction, that share of its series) by k-medoids on the DTW matrix of its
+    series and every part is averaged, and ``transform`` returns the distance to every
+    centroid: features for a downstream classifier.
 
     What to set: ``manifold`` for your data; ``method`` and ``preset`` choose the
     averaging (the default, density-weighted RTW means of the median class length, is
@@ -82,15 +82,18 @@ class RTWAverager(TransformerMixin, BaseEstimator):
     dtw_window_ : float or None
         The Sakoe-Chiba band used in the fit and by ``transform`` (``dtw_window``, or
         the one chosen for ``"auto"``).
-    n_centroids_ : int
-        Centroids per class (``n_centroids``, or the number chosen for ``"auto"``).
+    n_centroids_ : int or float
+        Centroids of every class: ``n_centroids``, or the value chosen for ``"auto"``
+        (a count, or a fraction of every class; ``np.bincount(centroid_classes_)`` gives
+        each class's number).
     selection_ : dict
         The training-data scores behind the ``"auto"`` choices (empty without them):
         ``"criterion"``, ``"prior"`` (the choice unless the data clearly prefer another),
         ``"candidates"`` (every candidate band and number of centroids with its
         leave-one-out accuracy and its advantage over the prior in standard errors,
-        ``"z"``), ``"n_series"`` and ``"sampled"`` (the series it was made on: a
-        stratified sample of a large training set) and ``"seconds"`` (part of the fit).
+        ``"z"``), ``"class_centroids"`` (the chosen number of every class),
+        ``"n_series"`` and ``"sampled"`` (the series it was made on: a stratified sample
+        of a large training set) and ``"seconds"`` (part of the fit).
     n_features_in_ : int
         Length of the training series when they all have the same length (a
         scikit-learn convention; series of any length are accepted by ``transform``).
@@ -207,7 +210,7 @@ class RTWAverager(TransformerMixin, BaseEstimator):
                 n_centroids = 1 if n_centroids == "auto" else n_centroids
         context = replace(context, dtw_window=window)
         owner = type(self).__name__
-        if n_centroids == 1:
+        if isinstance(n_centroids, int) and n_centroids == 1:
             groups, owners = codes, np.arange(len(classes))
             names, kind = list(classes), "class"
         else:

@@ -13,7 +13,9 @@ Class means (:class:`RTWAverager`), several centroids per class and clustering
   cluster of every unfinished problem in one :func:`fit_centroids` call.
 
 The estimators validate, resolve their settings and store the results; nothing is
-averaged or scored by a second implementation.
+averaged or scored by a second implementation. A group of one series is its own centroid
+(:class:`SeriesCentroid`) where the method's average of one series is that series
+(:meth:`~sk_rtw.methods.AveragingMethod.keeps_single_series`).
 """
 
 from __future__ import annotations
@@ -32,6 +34,30 @@ from ..utils import SeriesCollection, check_series_collection
 
 def _label(name: Any) -> Any:
     return name.item() if isinstance(name, np.generic) else name
+
+
+@dataclass(frozen=True, eq=False)
+class SeriesCentroid:
+    """The centroid of a group of one series: the series itself, nothing averaged.
+
+    The fields of :class:`~sk_rtw.methods.AveragingResult`: ``aligned`` is the series,
+    ``warps`` the identity, ``cost`` 0, ``n_iter`` 0; ``config`` is the method's
+    configuration (:meth:`~sk_rtw.methods.AveragingMethod.configure`), which did not run.
+    """
+
+    mean: np.ndarray
+    aligned: np.ndarray
+    warps: np.ndarray
+    config: Any
+    manifold: Any
+    cost: float = 0.0
+    n_iter: int = 0
+    fit_time: float = 0.0
+
+    @classmethod
+    def of(cls, series: np.ndarray, config: Any, manifold: Any) -> SeriesCentroid:
+        return cls(series, series[None], np.linspace(0.0, 1.0, len(series))[None], config,
+                   manifold)  # fmt: skip
 
 
 def fit_centroids(
@@ -78,15 +104,34 @@ def fit_centroids(
     n_groups = int(codes.max()) + 1
     names = list(range(n_groups)) if names is None else names
     start = time.perf_counter()
-    fitted = method.fit_groups(collection, codes, seeds, config, context, starts)
+    sizes = np.bincount(codes, minlength=n_groups)
+    fitted: list[Any] = [None] * n_groups
+    single = sizes == 1 if method.keeps_single_series(config) else np.zeros(n_groups, bool)
+    member = np.empty(n_groups, dtype=np.int64)
+    member[codes] = np.arange(len(codes))  # a group's only series, where it has one
+    for g in np.flatnonzero(single):
+        fitted[g] = SeriesCentroid.of(collection.series(member[g]), config, collection.manifold)
+    averaged = np.flatnonzero(~single)
+    if len(averaged):
+        rows = np.flatnonzero(~single[codes])
+        whole = len(rows) == len(codes)
+        results = method.fit_groups(
+            collection if whole else collection.subset(rows),
+            codes if whole else np.searchsorted(averaged, codes[rows]),
+            [seeds[g] for g in averaged], config, context,
+            None if starts is None else [starts[g] for g in averaged],
+        )  # fmt: skip
+        for g, result in zip(averaged, results, strict=True):
+            fitted[g] = result
     if context.verbose:
         seconds = time.perf_counter() - start
-        sizes = np.bincount(codes, minlength=n_groups)
         # a line per class or cluster; a line per centroid only at verbose >= 2
         for g in range(n_groups if kind != "centroid" or context.verbose >= 2 else 0):
+            what = ("the series itself" if single[g]
+                    else method.describe(fitted[g]))  # fmt: skip
             print(
                 f"[{owner}] {kind} {_label(names[g])!r}: {sizes[g]} series, {method.label}, "
-                f"{method.describe(fitted[g])}",
+                f"{what}",
                 file=sys.stderr,
                 flush=True,
             )

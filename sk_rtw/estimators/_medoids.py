@@ -1,16 +1,16 @@
 """k-medoids on a precomputed distance matrix, and leave-one-out nearest-medoid scores.
 
 Several centroids per class start from a partition of each class; the ``"auto"`` band and
-number of centroids are scored on held-out series. Both work on one DTW matrix per band,
-computed once (:mod:`sk_rtw.estimators._selection`), so that no candidate needs a new DTW:
+number of centroids are scored on held-out series. Both work on one DTW matrix per class
+and band, computed once (:mod:`sk_rtw.estimators._selection`):
 
 * :func:`kmedoids` -- deterministic k-medoids: the greedy BUILD of Kaufman and Rousseeuw
   (the series with the least total distance, then each next medoid the one that lowers
   the total distance most), then alternating assignment and medoid updates (Park and
   Jun, 2009) until nothing changes. Ties go to the lowest index, so the same matrix
   always gives the same partition.
-* :func:`loo_class_distances` -- every series' distance to the nearest medoid of every
-  class, its own class's medoids chosen without it (leave-one-out).
+* :func:`held_out_distances` -- every series' distance to the nearest medoid of its own
+  class, itself left out (a medoid is replaced in its cluster).
 """
 
 from __future__ import annotations
@@ -109,61 +109,51 @@ def kmedoids(D: np.ndarray, k: int):
 
 
 @njit(cache=True, nogil=True)
-def _submatrix(D, index):
-    n = index.shape[0]
-    out = np.empty((n, n))
-    for a in range(n):
-        for b in range(n):
-            out[a, b] = D[index[a], index[b]]
-    return out
+def held_out_distances(D: np.ndarray, medoids: np.ndarray, labels: np.ndarray) -> np.ndarray:
+    """Distance of every point of a class to the nearest of its class's medoids, itself
+    left out.
 
-
-@njit(cache=True, nogil=True)
-def loo_class_distances(D: np.ndarray, codes: np.ndarray, n_classes: int, k: int) -> np.ndarray:
-    """Distance of every series to the nearest of ``k`` medoids of every class.
-
-    The medoids of a series' own class are chosen without it (leave-one-out); those of
-    the other classes from the whole class.
+    A point that is not a medoid keeps the class's medoids; a medoid is left out of its
+    cluster, whose medoid becomes the member that minimises the total distance to the
+    cluster's other members (none if the cluster held only the point). With one medoid
+    per point this is exact leave-one-out 1-NN; refitting k-medoids without every point
+    (``n`` fits of ``O(k n^2)``) would be too costly for the classes of large training
+    sets, where the candidates reach every series.
 
     Parameters
     ----------
     D : ndarray of shape (n, n)
-        Distances between the series.
-    codes : ndarray of int, shape (n,)
-        Class of every series, ``0..n_classes - 1``.
-    n_classes : int
-    k : int
-        Medoids per class (at most the class size; one fewer when a series is left out).
+        Distances between the points of one class.
+    medoids, labels : ndarray of int
+        :func:`kmedoids` of ``D``.
 
     Returns
     -------
-    distances : ndarray of shape (n, n_classes)
-        ``inf`` where a class has no medoid (a series alone in its class, left out).
+    distances : ndarray of shape (n,)
+        ``inf`` for a point alone in its class.
     """
-    n = D.shape[0]
-    out = np.full((n, n_classes), np.inf)
-    for c in range(n_classes):
-        members = np.flatnonzero(codes == c)
-        size = members.shape[0]
-        if size == 0:
+    n, k = D.shape[0], medoids.shape[0]
+    is_medoid = np.full(n, -1, dtype=np.int64)
+    for m in range(k):
+        is_medoid[medoids[m]] = m
+    out = np.full(n, np.inf)
+    for i in range(n):
+        own = is_medoid[i]
+        for m in range(k):
+            if m != own and D[i, medoids[m]] < out[i]:
+                out[i] = D[i, medoids[m]]
+        if own < 0:
             continue
-        medoids, _ = kmedoids(_submatrix(D, members), min(k, size))
-        chosen = members[medoids]
-        for i in range(n):
-            if codes[i] == c:
+        best, best_total = -1, np.inf  # the cluster's medoid without i
+        for c in range(n):
+            if c == i or labels[c] != own:
                 continue
-            for m in chosen:
-                if D[i, m] < out[i, c]:
-                    out[i, c] = D[i, m]
-        if size == 1:
-            continue
-        rest = np.empty(size - 1, dtype=np.int64)
-        for a in range(size):  # leave member a out, choose its class's medoids again
-            rest[:a] = members[:a]
-            rest[a:] = members[a + 1 :]
-            medoids, _ = kmedoids(_submatrix(D, rest), min(k, size - 1))
-            i = members[a]
-            for m in rest[medoids]:
-                if D[i, m] < out[i, c]:
-                    out[i, c] = D[i, m]
+            total = 0.0
+            for j in range(n):
+                if j != i and labels[j] == own:
+                    total += D[c, j]
+            if total < best_total:
+                best, best_total = c, total
+        if best >= 0 and D[i, best] < out[i]:
+            out[i] = D[i, best]
     return out

@@ -22,12 +22,15 @@ METHOD = method_parameter(
 )
 N_CENTROIDS = Parameter(
     "n_centroids",
-    (Interval(int, 1), Options(("auto",))),
-    "Centroids per class. Above 1 each class is split into that many parts by k-medoids "
-    "on the DTW matrix of its series (band ``dtw_window``; at most one part per series) "
-    'and every part is averaged once. "auto": the preset\'s value, as for every "auto" of '
-    'the package: chosen from the training data with the band (fitted ``n_centroids_``, '
-    'the scores in ``selection_``) under "class-means" and "alignment", one mean per class '
+    (Interval(int, 1), Interval(float, 0.0, 1.0, closed="right"), Options(("auto",))),
+    "Centroids per class: an integer is a count for every class (at most its series), a "
+    "float in (0, 1] a fraction of every class, rounded up (1.0: every series is a "
+    "centroid, 1-NN DTW within the band), so that large classes get more centroids. Each "
+    "class is split into its parts by k-medoids on the DTW matrix of its series (band "
+    "``dtw_window``) and every part of several series is averaged once; a part of one "
+    'series is that series. "auto": the preset\'s value, as for every "auto" of the '
+    "package: chosen from the training data with the band (fitted ``n_centroids_``, the "
+    'scores in ``selection_``) under "class-means" and "alignment", one mean per class '
     'under "paper".',
 )
 DTW_WINDOW = Parameter(

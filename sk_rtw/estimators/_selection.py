@@ -1,15 +1,21 @@
-"""Choices made from the training data: the DTW band and the number of centroids per class.
+"""Choices made from the training data: the DTW band and the centroids of every class.
 
 ``dtw_window="auto"`` and ``n_centroids="auto"`` (:class:`~sk_rtw.RTWNearestCentroid`'s
 defaults) are resolved in ``fit``, before the centroids are averaged, into
-``dtw_window_`` and ``n_centroids_``. Everything is computed once and scored many times:
+``dtw_window_`` and ``n_centroids_``. A number of centroids is a count per class (an
+integer, at most the class's series) or a fraction of every class (a float in (0, 1],
+rounded up, at least one centroid: :func:`class_counts`), so that a class's centroids
+follow its size; ``1.0`` makes every series a centroid (1-NN DTW within the band).
+Everything is computed once and scored many times:
 
-1. one DTW matrix of the training series per candidate band (:data:`WINDOWS`);
-2. every candidate (band, centroids per class of :data:`CENTROIDS`) is scored by
-   leave-one-out nearest-medoid classification on that matrix: each series is given the
-   class of the nearest of ``k`` medoids per class, its own class's medoids chosen
-   without it (:func:`~sk_rtw.estimators._medoids.loo_class_distances`); no centroid is
-   averaged and no new DTW is computed;
+1. one DTW matrix of every class's training series per candidate band (:data:`WINDOWS`);
+2. every candidate (band, centroids of :data:`CENTROIDS`) is scored by leave-one-out
+   nearest-medoid classification: k-medoids of every class on its matrix; each series'
+   distance to its own class is the nearest of that class's medoids, a medoid itself
+   left out and replaced in its cluster
+   (:func:`~sk_rtw.estimators._medoids.held_out_distances`), and its distance to every
+   other class the nearest of their medoids (:func:`~sk_rtw.dtw.dtw_nearest_distance`:
+   lower bounds and early abandoning). No centroid is averaged;
 3. the choice is the prior :data:`PRIOR` unless another candidate classifies the
    held-out series better by at least :data:`Z_THRESHOLD` standard errors of the paired
    difference (McNemar's statistic on the series where exactly one of the two is right);
@@ -17,24 +23,21 @@ defaults) are resolved in ``fit``, before the centroids are averaged, into
 
 The criterion is deterministic (no folds to draw), so the choice does not depend on
 ``random_state`` unless the training set is sampled. On more than :data:`MAX_SERIES`
-series, or when the matrices would exceed :data:`CELLS_PER_POINT` DTW cells per training
-sample, the choice is made on a stratified random sample (``selection_["n_series"]``).
-The matrix of the chosen band then gives each class's partition into ``k`` parts
-(:func:`partition`), and the averaging method fits every part once.
+series, or when the class matrices would exceed :data:`CELLS_PER_POINT` DTW cells per
+training sample, the choice is made on a stratified random sample
+(``selection_["n_series"]``); a fraction then applies to the full classes. Finally
+(:func:`partition`) every class is split into its count of parts by k-medoids (on the
+choice's matrix when the class was scored whole, in chunks of at most
+:data:`PART_SERIES` series beyond), and the averaging method fits every part once.
 
-Why these values (UCR development archive, 30 datasets in two fixed halves, docs: UCR
-benchmark; ``benchmarks/ucr/candidates.py``): the grid and the rule were chosen on half A
-from the test accuracy of every candidate's centroids, and confirmed on half B.
-Cross-validated accuracy on training sets of 16-60 series is too noisy to pick the best of
-16-20 candidates (the previous rule, the best 3-fold accuracy of DBA centroids, kept the
-same choice on all of 3 seeds for 8 of 30 datasets and trailed 1-NN DTW on half A); a good
-prior that the data must clearly beat does better on both halves. The full band was never
-chosen over the narrower ones by any rule measured and costs more than the four others
-together, so it is not a candidate.
+Why these values: docs, UCR benchmark ("the default classifier"), measured with
+``benchmarks/ucr/candidates.py`` on half A of the development archive and on half C1 of
+the large training sets, confirmed on halves B and C2.
 """
 
 from __future__ import annotations
 
+import math
 import sys
 import time
 from dataclasses import dataclass, field
@@ -43,23 +46,47 @@ from typing import Any
 import numpy as np
 from sklearn.utils import check_random_state
 
-from ..dtw import dtw_pairwise_distance
+from ..dtw import dtw_nearest_distance, dtw_pairwise_distance
 from ..utils import SeriesCollection
-from ._medoids import kmedoids, loo_class_distances
+from ._medoids import held_out_distances, kmedoids
 
-#: Candidate Sakoe-Chiba radii of ``dtw_window="auto"``.
-WINDOWS: tuple[float, ...] = (0.0, 0.05, 0.1, 0.2)
-#: Candidate centroids per class of ``n_centroids="auto"``.
-CENTROIDS: tuple[int, ...] = (1, 2, 4, 8)
+#: Candidate Sakoe-Chiba radii of ``dtw_window="auto"`` (None: no band).
+WINDOWS: tuple[float | None, ...] = (0.0, 0.05, 0.1, 0.2, None)
+#: Candidate centroids of ``n_centroids="auto"``: one per class, or a fraction of every
+#: class (1.0: every series).
+CENTROIDS: tuple[int | float, ...] = (1, 0.125, 0.25, 0.5, 1.0)
 #: The choice unless the training data clearly prefer another candidate.
-PRIOR: tuple[float, int] = (0.05, 8)
+PRIOR: tuple[float | None, int | float] = (None, 0.25)
 #: Standard errors by which a candidate must beat the prior on the held-out series.
 Z_THRESHOLD = 1.0
 #: Most training series the choice is made on (a stratified sample beyond).
-MAX_SERIES = 500
-#: DTW cells of the selection's matrices per sample of the training set (sum of the
-#: series lengths): about the work of one plain fit (docs: UCR benchmark).
+MAX_SERIES = 1000
+#: DTW cells of the choice's class matrices per sample of the training set (sum of the
+#: series lengths).
 CELLS_PER_POINT = 40_000
+#: Largest class split into centroids by one k-medoids; larger ones are split in chunks.
+PART_SERIES = 500
+
+
+def class_counts(n_centroids: int | float, sizes: np.ndarray) -> np.ndarray:
+    """Centroids of every class: ``min(n_centroids, size)`` for an integer, ``ceil(f size)``
+    (at least one) for a fraction ``f``.
+
+    Parameters
+    ----------
+    n_centroids : int or float
+    sizes : ndarray of int
+        Series of every class.
+
+    Returns
+    -------
+    ndarray of int
+    """
+    sizes = np.asarray(sizes, dtype=np.int64)
+    if isinstance(n_centroids, (int, np.integer)):
+        return np.minimum(int(n_centroids), sizes)
+    counts = np.ceil(float(n_centroids) * sizes - 1e-9).astype(np.int64)
+    return np.clip(counts, 1, np.maximum(sizes, 1))
 
 
 @dataclass
@@ -69,14 +96,15 @@ class Selection:
     Attributes
     ----------
     dtw_window : float or None
-    n_centroids : int
+    n_centroids : int or float
     report : dict
         ``selection_``: criterion, prior, every candidate's held-out accuracy and
         statistic, the sample size and the seconds.
     sample : ndarray of int
         Training series the matrices cover (all of them unless sampled).
-    matrices : dict
-        DTW matrix of the sample per band.
+    medoids : dict
+        :func:`candidate_key` -> per class, the k-medoids labels of its sampled
+        series (what :func:`partition` reuses for a class scored whole).
     held_out : ndarray of shape (n_sample, n_classes)
         Leave-one-out distance of every sampled series to every class under the chosen
         candidate (what the probability temperature is fitted on); ``inf`` for the class
@@ -84,10 +112,10 @@ class Selection:
     """
 
     dtw_window: float | None
-    n_centroids: int
+    n_centroids: int | float
     report: dict[str, Any]
     sample: np.ndarray
-    matrices: dict[float | None, np.ndarray] = field(default_factory=dict)
+    medoids: dict[tuple[Any, Any], list[np.ndarray]] = field(default_factory=dict)
     held_out: np.ndarray = field(default_factory=lambda: np.empty((0, 0)))
 
 
@@ -102,16 +130,18 @@ def selection_sample(
     collection: SeriesCollection, codes: np.ndarray, windows, rng: np.random.RandomState
 ) -> np.ndarray:
     """Indices of the series the choice is made on: all of them, or a stratified sample
-    within :data:`MAX_SERIES` and the :data:`CELLS_PER_POINT` budget (every class keeps
-    at least two series, or all it has)."""
+    within :data:`MAX_SERIES` and the :data:`CELLS_PER_POINT` budget of the class
+    matrices (every class keeps at least two series, or all it has)."""
     n = collection.n_series
     lengths = collection.lengths
+    sizes = np.bincount(codes)
     pair = sum(band_cells(float(np.mean(lengths)), w) for w in windows)
     budget = CELLS_PER_POINT * float(lengths.sum())
-    size = int(min(n, MAX_SERIES, np.sqrt(2.0 * budget / max(pair, 1.0))))
+    # a sample of m series holds about m^2 sum(p_c^2) / 2 pairs of the same class
+    same_class = float(np.sum((sizes / n) ** 2))
+    size = int(min(n, MAX_SERIES, np.sqrt(2.0 * budget / max(pair * same_class, 1.0))))
     if size >= n:
         return np.arange(n)
-    sizes = np.bincount(codes)
     keep = []
     for c, n_c in enumerate(sizes):
         quota = min(int(n_c), max(2, round(size * n_c / n)))
@@ -127,8 +157,157 @@ def mcnemar(candidate: np.ndarray, prior: np.ndarray) -> float:
     return (better - worse) / np.sqrt(better + worse) if better + worse else 0.0
 
 
+def candidate_key(window: float | None, n_centroids: int | float) -> tuple:
+    """A candidate as a dictionary key: ``1`` (one centroid per class) and ``1.0`` (every
+    series) are equal numbers but different candidates."""
+    return (window, isinstance(n_centroids, float), n_centroids)
+
+
 def _width(window: float | None) -> float:
     return 2.0 if window is None else float(window)
+
+
+def _centroid_order(n_centroids: int | float) -> float:
+    """Fewer centroids first: a count before every fraction, then by size."""
+    if isinstance(n_centroids, (int, np.integer)):
+        return float(n_centroids) - 1e6
+    return float(n_centroids)
+
+
+def class_medoids(D: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
+    """k-medoids of one class's matrix; every series its own medoid when ``k`` is its size."""
+    n = D.shape[0]
+    if k >= n:
+        return np.arange(n), np.arange(n)
+    return kmedoids(np.ascontiguousarray(D), k)
+
+
+@dataclass
+class Partition:
+    """One candidate's k-medoids of every class (:func:`class_partitions`)."""
+
+    #: Held-out distance of every series to its own class (leave-one-out).
+    own: np.ndarray
+    #: Per class, the k-medoids label of each of its series.
+    labels: list[np.ndarray]
+    #: Positions of every class's medoids among the series, class after class.
+    medoids: np.ndarray
+
+
+def class_partitions(
+    matrices: list[np.ndarray], members: list[np.ndarray], n_centroids: int | float
+) -> Partition:
+    """k-medoids of every class on its matrix under one candidate's count.
+
+    Parameters
+    ----------
+    matrices : list of ndarray
+        Per class, the DTW matrix of its series.
+    members : list of ndarray
+        Per class, the positions of its series among all.
+    n_centroids : int or float
+
+    Returns
+    -------
+    Partition
+    """
+    counts = class_counts(n_centroids, np.array([len(m) for m in members]))
+    own = np.empty(sum(len(m) for m in members))
+    labels, references = [], []
+    for c, D in enumerate(matrices):
+        medoids, part = class_medoids(D, int(counts[c]))
+        own[members[c]] = held_out_distances(D, medoids, part)
+        labels.append(part)
+        references.append(members[c][medoids])
+    return Partition(own, labels, np.concatenate(references))
+
+
+@dataclass
+class NearestOther:
+    """Every series' nearest series of another class, where it is at most ``limit``
+    (:func:`nearest_other_class`)."""
+
+    #: ``(n, n_classes)``: the nearest other class's distance (and any tied with it),
+    #: ``inf`` elsewhere and where none is at most the limit.
+    distances: np.ndarray
+    #: ``(n,)``: the distance up to which ``distances`` is known.
+    limit: np.ndarray
+
+
+def nearest_other_class(
+    subset: SeriesCollection,
+    codes: np.ndarray,
+    limit: np.ndarray,
+    window: float | None,
+    n_jobs: int | None = None,
+) -> NearestOther:
+    """Each series' nearest series of another class, where it is at most ``limit``: with
+    the own-class distances of a band's candidates as the limit, one search that settles
+    most series of every candidate (:func:`held_out_scores`)."""
+    distances = dtw_nearest_distance(
+        subset, subset, codes, window=window, exclude_group=codes, max_distance=limit,
+        nearest_only=True, n_jobs=n_jobs,
+    )  # fmt: skip
+    return NearestOther(distances, limit)
+
+
+def held_out_scores(
+    subset: SeriesCollection,
+    codes: np.ndarray,
+    partition: Partition,
+    window: float | None,
+    every_class: bool = True,
+    nearest_other: NearestOther | None = None,
+    n_jobs: int | None = None,
+) -> np.ndarray:
+    """Leave-one-out nearest-medoid distances of one candidate (module docstring, step 2).
+
+    Parameters
+    ----------
+    subset : SeriesCollection
+        The series scored.
+    codes : ndarray of int, shape (n,)
+        Their classes.
+    partition : Partition
+        The candidate's k-medoids of every class (:func:`class_partitions`).
+    window : float or None
+        The candidate's band.
+    every_class : bool, default=True
+        False: the other classes only where one is nearer than (or as near as) a series'
+        own (``inf`` elsewhere): the same ``argmin``, from far fewer DTWs.
+    nearest_other : NearestOther, optional
+        With ``every_class=False``: :func:`nearest_other_class` of the band. A series
+        farther from every other class than from its own needs no search (no medoid of
+        another class can be nearer), nor one whose every series is a medoid (the
+        nearest other series is the nearest other medoid), where the limit covers its
+        own distance.
+    n_jobs : int, optional
+
+    Returns
+    -------
+    held_out : ndarray of shape (n, n_classes)
+    """
+    own, chosen = partition.own, partition.medoids
+    n = subset.n_series
+    held_out = np.full((n, len(partition.labels)), np.inf)
+    rows = np.arange(n)
+    if not every_class and nearest_other is not None:
+        known = own <= nearest_other.limit
+        nearest = nearest_other.distances.min(1)
+        if len(chosen) == n:  # every series a medoid: the search is the band's
+            held_out[known] = np.where(nearest_other.distances[known] <= own[known, None],
+                                       nearest_other.distances[known], np.inf)  # fmt: skip
+            rows = np.flatnonzero(~known)
+        else:
+            rows = np.flatnonzero(~known | (nearest <= own))
+    if len(rows):
+        held_out[rows] = dtw_nearest_distance(
+            subset.subset(rows), subset.subset(chosen), codes[chosen], window=window,
+            exclude_group=codes[rows], max_distance=None if every_class else own[rows],
+            nearest_only=not every_class, n_jobs=n_jobs,
+        )  # fmt: skip
+    held_out[np.arange(n), codes] = own
+    return held_out
 
 
 def choose(
@@ -142,7 +321,7 @@ def choose(
     verbose: int = 0,
     owner: str = "RTWNearestCentroid",
 ) -> Selection:
-    """Resolve ``"auto"`` band and centroids per class (module docstring).
+    """Resolve ``"auto"`` band and centroids (module docstring).
 
     Parameters
     ----------
@@ -151,11 +330,11 @@ def choose(
     codes : ndarray of int, shape (n_series,)
         Class of every series, ``0..n_classes - 1`` (at least two classes).
     window : float, None or "auto"
-    n_centroids : int or "auto"
+    n_centroids : int, float or "auto"
     random_state : int, RandomState or None
         Draws the sample of a large training set.
     n_jobs : int, optional
-        Threads of the DTW matrices.
+        Threads of the DTW matrices and searches.
     verbose : int
         1 and more: one line with the choice and its cost.
     owner : str
@@ -167,7 +346,7 @@ def choose(
     """
     start = time.perf_counter()
     windows = WINDOWS if window == "auto" else (window,)
-    counts = CENTROIDS if n_centroids == "auto" else (int(n_centroids),)
+    counts = CENTROIDS if n_centroids == "auto" else (n_centroids,)
     prior = (
         PRIOR[0] if window == "auto" else window,
         PRIOR[1] if n_centroids == "auto" else counts[0],
@@ -177,24 +356,41 @@ def choose(
     subset = collection.subset(sample)
     sampled_codes = codes[sample]
     n_classes = int(codes.max()) + 1
-    matrices = {w: dtw_pairwise_distance(subset, window=w, n_jobs=n_jobs) for w in windows}
-    outcomes, distances = {}, {}
-    for w in windows:
-        for k in counts:
-            held_out = loo_class_distances(matrices[w], sampled_codes, n_classes, k)
-            distances[w, k] = held_out
-            outcomes[w, k] = held_out.argmin(1) == sampled_codes
-    if prior not in outcomes:  # a fixed value the grid does not hold: score it too
-        held_out = loo_class_distances(matrices[prior[0]], sampled_codes, n_classes, prior[1])
-        distances[prior], outcomes[prior] = held_out, held_out.argmin(1) == sampled_codes
-    statistics = {q: mcnemar(outcomes[q], outcomes[prior]) for q in outcomes}
+    members = [np.flatnonzero(sampled_codes == c) for c in range(n_classes)]
+    candidates = {candidate_key(w, k): (w, k) for w in windows for k in counts}
+    candidates.setdefault(candidate_key(*prior), prior)  # a fixed value off the grid
+    outcomes, partitions, matrices = {}, {}, {}
+    for w in dict.fromkeys(w for w, _ in candidates.values()):
+        matrices[w] = [
+            dtw_pairwise_distance(subset.subset(m), window=w, n_jobs=n_jobs) for m in members
+        ]
+        keys = [q for q, c in candidates.items() if c[0] == w]
+        for q in keys:
+            partitions[q] = class_partitions(matrices[w], members, candidates[q][1])
+        # the one-per-class candidates' own distances are large, and their own search
+        # cheap: the shared search stops at the others'
+        shares = [q for q in keys if isinstance(candidates[q][1], float)] or keys
+        limit = np.max([partitions[q].own for q in shares], axis=0)
+        nearest = nearest_other_class(subset, sampled_codes, limit, w, n_jobs)
+        for q in keys:
+            held_out = held_out_scores(subset, sampled_codes, partitions[q], w,
+                                       every_class=False, nearest_other=nearest,
+                                       n_jobs=n_jobs)  # fmt: skip
+            outcomes[q] = held_out.argmin(1) == sampled_codes
+    base = outcomes[candidate_key(*prior)]
+    statistics = {q: mcnemar(outcomes[q], base) for q in outcomes}
     best = max(statistics.values())
     chosen = prior
     if best >= Z_THRESHOLD:
         chosen = min(
-            (q for q, z in statistics.items() if z >= best - 1e-12),
-            key=lambda q: (q[1], _width(q[0])),
+            (candidates[q] for q, z in statistics.items() if z >= best - 1e-12),
+            key=lambda c: (_centroid_order(c[1]), _width(c[0])),
         )
+    # every class's held-out distance under the choice (the probability temperature's)
+    chosen_key = candidate_key(*chosen)
+    held_out = held_out_scores(subset, sampled_codes, partitions[chosen_key], chosen[0],
+                               n_jobs=n_jobs)  # fmt: skip
+    sizes = np.bincount(codes, minlength=n_classes)
     report: dict[str, Any] = {
         "criterion": (
             "leave-one-out nearest-medoid accuracy on the training series; the prior "
@@ -206,41 +402,45 @@ def choose(
             {
                 "dtw_window": w,
                 "n_centroids": k,
-                "accuracy": float(outcomes[w, k].mean()),
-                "z": float(statistics[w, k]),
+                "accuracy": float(outcomes[q].mean()),
+                "z": float(statistics[q]),
             }
-            for (w, k) in outcomes
+            for q, (w, k) in candidates.items()
         ],
+        "class_centroids": class_counts(chosen[1], sizes).tolist(),
         "n_series": len(sample),
         "sampled": len(sample) < collection.n_series,
         "seconds": time.perf_counter() - start,
     }
     if verbose:
         print(
-            f"[{owner}] chose dtw_window={chosen[0]}, n_centroids={chosen[1]} from "
-            f"{len(outcomes)} candidates on {len(sample)} of {collection.n_series} series "
-            f"(held-out accuracy {outcomes[chosen].mean():.3f}) in {report['seconds']:.1f} s",
+            f"[{owner}] chose dtw_window={chosen[0]}, n_centroids={chosen[1]} "
+            f"({int(np.sum(report['class_centroids']))} centroids) from {len(outcomes)} "
+            f"candidates on {len(sample)} of {collection.n_series} series (held-out "
+            f"accuracy {outcomes[chosen_key].mean():.3f}) in {report['seconds']:.1f} s",
             file=sys.stderr,
             flush=True,
         )
-    return Selection(chosen[0], chosen[1], report, sample, matrices, distances[chosen])
+    medoids = {q: partition.labels for q, partition in partitions.items()}
+    return Selection(chosen[0], chosen[1], report, sample, medoids, held_out)
 
 
 def partition(
     collection: SeriesCollection,
     codes: np.ndarray,
-    n_centroids: int,
+    n_centroids: int | float,
     window: float | None,
     *,
     selection: Selection | None = None,
     random_state: Any = None,
     n_jobs: int | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Split every class into ``min(n_centroids, class size)`` parts by k-medoids on DTW.
+    """Split every class into its count of parts (:func:`class_counts`) by k-medoids on DTW.
 
-    Each class's medoids come from the DTW matrix (band ``window``) of its series, or of
-    at most :data:`MAX_SERIES` of them (the selection's sample when there is one); every
-    series joins its nearest medoid.
+    A class of one part needs no DTW, nor does one whose every series is a part. A class
+    the selection scored whole reuses its k-medoids; another is split on the DTW matrix
+    (band ``window``) of its series, in random chunks of at most :data:`PART_SERIES`
+    series (each with its share of the parts) when it is larger.
 
     Returns
     -------
@@ -250,31 +450,60 @@ def partition(
         Class of every part.
     """
     rng = check_random_state(random_state)
+    n_classes = int(codes.max()) + 1
+    sizes = np.bincount(codes, minlength=n_classes)
+    counts = class_counts(n_centroids, sizes)
+    key = candidate_key(window, n_centroids)
+    reused = None if selection is None else selection.medoids.get(key)
     groups = np.empty(collection.n_series, dtype=np.int64)
     owners: list[int] = []
-    matrix = None if selection is None else selection.matrices.get(window)
-    for c in range(int(codes.max()) + 1):
+    for c in range(n_classes):
         members = np.flatnonzero(codes == c)
-        if matrix is not None:
-            position = np.flatnonzero(codes[selection.sample] == c)  # type: ignore[union-attr]
-            chosen = selection.sample[position]  # type: ignore[union-attr]
-            D = matrix[np.ix_(position, position)]
+        k = int(counts[c])
+        if k == 1:
+            part = np.zeros(len(members), dtype=np.int64)
+        elif k == len(members):
+            part = np.arange(len(members))
+        elif reused is not None and len(reused[c]) == len(members):
+            part = reused[c]  # the selection's sample holds the whole class, in order
         else:
-            chosen = members
-            if len(members) > MAX_SERIES:
-                chosen = np.sort(rng.choice(members, MAX_SERIES, replace=False))
-            D = dtw_pairwise_distance(collection.subset(chosen), window=window, n_jobs=n_jobs)
-        k = min(n_centroids, len(members), len(chosen))
-        medoids, labels = kmedoids(np.ascontiguousarray(D), k)
-        if len(chosen) == len(members):
-            part = labels
-        else:  # the series outside the sample join their nearest medoid
-            to_medoids = dtw_pairwise_distance(
-                collection.subset(members), collection.subset(chosen[medoids]),
-                window=window, n_jobs=n_jobs,
-            )  # fmt: skip
-            part = to_medoids.argmin(1)
-            part[np.searchsorted(members, chosen[medoids])] = np.arange(k)
+            part = _split(collection, members, k, window, rng, n_jobs)
         groups[members] = len(owners) + part
         owners += [c] * k
     return groups, np.asarray(owners, dtype=np.int64)
+
+
+def _split(
+    collection: SeriesCollection,
+    members: np.ndarray,
+    k: int,
+    window: float | None,
+    rng: np.random.RandomState,
+    n_jobs: int | None,
+) -> np.ndarray:
+    """k-medoids labels of one class, in chunks of at most :data:`PART_SERIES` series."""
+    n_chunks = math.ceil(len(members) / PART_SERIES)
+    order = np.arange(len(members)) if n_chunks == 1 else rng.permutation(len(members))
+    chunks = np.array_split(order, n_chunks)
+    shares = _apportion(k, np.array([len(chunk) for chunk in chunks]))
+    part = np.empty(len(members), dtype=np.int64)
+    offset = 0
+    for chunk, share in zip(chunks, shares, strict=True):
+        D = dtw_pairwise_distance(collection.subset(members[np.sort(chunk)]), window=window,
+                                  n_jobs=n_jobs)  # fmt: skip
+        _, labels = class_medoids(D, int(share))
+        part[np.sort(chunk)] = offset + labels
+        offset += int(share)
+    return part
+
+
+def _apportion(k: int, sizes: np.ndarray) -> np.ndarray:
+    """``k`` parts shared among chunks in proportion to their sizes (largest remainders),
+    at least one each."""
+    exact = k * sizes / sizes.sum()
+    shares = np.maximum(1, np.floor(exact).astype(np.int64))
+    for i in np.argsort(-(exact - np.floor(exact)), kind="stable"):
+        if shares.sum() >= k:
+            break
+        shares[i] += 1
+    return np.minimum(shares, sizes)

@@ -185,6 +185,22 @@ class AveragingMethod(BaseEstimator):
             One result per group, in group order.
         """
 
+    def keeps_single_series(self, config: Any) -> bool:
+        """Whether the average of a group of one series is that series, unchanged, under
+        ``config``: the estimators then take the series as its group's centroid without
+        a fit. False unless a method says so (the shipped ones do where it holds).
+
+        Parameters
+        ----------
+        config
+            What :meth:`configure` returned.
+
+        Returns
+        -------
+        bool
+        """
+        return False
+
     def describe(self, result: Any) -> str:
         """A few words on one fitted group, for the estimators' ``verbose`` lines."""
         return f"cost {result.cost:.4g} after {result.n_iter} iterations"

@@ -74,6 +74,10 @@ class DBA(AveragingMethod):
         values = resolve_knobs(self.name, context.preset, given)
         return DBAConfig(self.name, context.preset, values["max_iter"], values["tol"], None)
 
+    def keeps_single_series(self, config: DBAConfig) -> bool:
+        """True: the average starts at the group's medoid, the series, and stays there."""
+        return True
+
     def fit_groups(
         self,
         collection: SeriesCollection,

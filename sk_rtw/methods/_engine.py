@@ -65,6 +65,11 @@ class EngineMethod(AveragingMethod):
                 fitted[g] = result
         return fitted
 
+    def keeps_single_series(self, config: AlignmentConfig) -> bool:
+        """True unless an output length is given: every preset's rule gives one series its
+        own length, and its warp is the identity."""
+        return config.output_length is None
+
     def describe(self, result: Any) -> str:
         return f"best epoch {result.best_epoch + 1} of {result.n_iter} run"
 
