@@ -10,8 +10,10 @@ import pytest
 
 from benchmarks.ucr._data import load_split
 from benchmarks.ucr._protocol import paired_test
+from benchmarks.ucr._summary import HALF_C1, HALF_C2, halves
 from benchmarks.ucr.run import main
-from sk_rtw import RTWNearestCentroid
+from sk_rtw import RTWNearestCentroid, dtw_pairwise_distance
+from sk_rtw.estimators._selection import CENTROIDS, PRIOR, WINDOWS
 
 from .conftest import UCR_DIR
 
@@ -282,14 +284,16 @@ def test_default_rows_make_the_same_choice_and_the_halves_report_adds_up(tmp_pat
         assert [c["z"] for c in dba["selection"]["candidates"]] == [
             c["z"] for c in rtw["selection"]["candidates"]
         ]
-        assert len(dba["selection"]["candidates"]) == 16
+        assert len(dba["selection"]["candidates"]) == len(WINDOWS) * len(CENTROIDS)
         assert rtw["fit_seconds"] >= rtw["selection"]["seconds"] > 0
         one = record["methods"]["dba"]
         assert (one["dtw_window"], one["n_centroids"], one["selection"]) == (None, 1, {})
         assert len(one["output_length"]) == record["n_classes"]
     summary = (out / "summary.md").read_text().split("## Halves")[1]
-    assert "Half A: alphabetical positions 1, 3, 5, ... (ArrowHead, ItalyPowerDemand)" in summary
-    assert "half B: 2, 4, 6, ... (GunPoint)" in summary
+    assert (
+        "Half A: alphabetical positions 1, 3, 5, ... of the other datasets (ArrowHead, "
+        "ItalyPowerDemand); Half B: 2, 4, 6, ... (GunPoint)" in summary
+    )
     row = next(line for line in summary.splitlines() if line.startswith("| dba | 0"))
     half_a = np.mean(
         [records[n]["methods"]["dba"]["accuracy"] for n in ("ArrowHead", "ItalyPowerDemand")]
@@ -320,17 +324,67 @@ def test_the_candidates_benchmark_scores_every_candidate_and_the_prior_rule(tmp_
     candidates.main(["--data-dir", str(tmp_path), "--datasets", "GunPoint", "ItalyPowerDemand",
                      "--methods", "dba", "--out", str(out)])  # fmt: skip
     printed = capsys.readouterr().out
-    assert "| prior 0.05, k=8, z=1.0 |" in printed and "| best leave-one-out score |" in printed
+    prior = candidates.key(*PRIOR)
+    assert f"| prior {prior.replace('|', ', k=')}, z=1.0 |" in printed
+    assert "| best leave-one-out score |" in printed
     record = json.loads((out / "GunPoint.json").read_text())
-    grid = len(candidates.BANDS) * len(candidates.CENTROIDS)
-    assert len(record["test"]["dba"]) == len(record["loo"]) == grid
+    grid = [candidates.key(w, k) for w in WINDOWS for k in CENTROIDS]
+    assert list(record["test"]["dba"]) == list(record["loo"]) == grid
     train = load_split("GunPoint", "train", None)
     clf = RTWNearestCentroid(method="dba").fit(train.X, train.y)
-    inner = [candidates.key(w, k) for w in candidates.BANDS if w is not None
-             for k in candidates.CENTROIDS if k <= 8]  # fmt: skip
-    assert candidates.prior_rule(record["loo"], "0.05|8", 1.0, inner) == candidates.key(
-        clf.dtw_window_, clf.n_centroids_
-    )
+    chosen = candidates.key(clf.dtw_window_, clf.n_centroids_)
+    assert candidates.prior_rule(record["loo"], prior, 1.0, grid) == chosen
     test = load_split("GunPoint", "test", None)
-    fixed = record["test"]["dba"][candidates.key(clf.dtw_window_, clf.n_centroids_)]
-    assert fixed == pytest.approx(clf.score(test.X, test.y))
+    assert record["test"]["dba"][chosen] == pytest.approx(clf.score(test.X, test.y))
+    assert candidates.parse(candidates.key(None, 1.0)) == (None, 1.0)
+    assert candidates.parse(candidates.key(0.05, 1)) == (0.05, 1)
+
+
+def test_the_halves_of_the_archive_and_of_the_large_training_sets():
+    names = ["Beef", "ArrowHead", "Crop", "Computers", "Coffee", "ElectricDevices"]
+    assert halves(names) == {
+        "A": ["ArrowHead", "Coffee"],
+        "B": ["Beef"],
+        "C1": ["Computers", "Crop"],
+        "C2": ["ElectricDevices"],
+    }
+    assert not set(HALF_C1) & set(HALF_C2) and len(HALF_C1) == len(HALF_C2) == 3
+
+
+def test_1nn_with_a_learned_band_and_a_resume_across_seeds(tmp_path, capsys):
+    """The learned band is the leave-one-out best of the candidates' bands (squared costs,
+    ties to the narrower); --resume keeps finished methods with the same settings, and
+    the 1-NN rows across seeds."""
+    out = tmp_path / "run"
+    args = ["--datasets", "ItalyPowerDemand", "--methods", "dba", "1nn-dtw-band",
+            "--max-series-per-class", "10", "--quiet", "--out", str(out)]  # fmt: skip
+    assert main(args) == 0
+    path = out / "datasets" / "ItalyPowerDemand.json"
+    record = json.loads(path.read_text())
+    entry = record["methods"]["1nn-dtw-band"]
+    train = load_split("ItalyPowerDemand", "train", None)
+    kept = np.asarray(record["train_index"])
+    X, y = train.X[kept], train.y[kept]
+    scores = {}
+    for window in WINDOWS:
+        D = dtw_pairwise_distance(X, window=window, squared=True)
+        np.fill_diagonal(D, np.inf)
+        scores[window] = float(np.mean(y[D.argmin(1)] == y))
+    best = max(scores.values())
+    assert entry["dtw_window"] == next(w for w in WINDOWS if scores[w] == best)
+    test = load_split("ItalyPowerDemand", "test", None)
+    nearest = dtw_pairwise_distance(test.X, X, window=entry["dtw_window"], squared=True)
+    assert entry["accuracy"] == pytest.approx(np.mean(y[nearest.argmin(1)] == test.y))
+    # the same settings: nothing to do; another seed: the 1-NN row is kept, DBA is not
+    # (with --max-series-per-class the seed draws the training series: both are redone)
+    mtime = path.stat().st_mtime_ns
+    assert main([*args, "--resume"]) == 0
+    assert path.stat().st_mtime_ns == mtime
+    full = [a for a in args if a not in ("--max-series-per-class", "10")]
+    assert main(full) == 0
+    before = json.loads(path.read_text())["methods"]
+    assert main([*full, "--resume", "--seed", "1"]) == 0
+    after = json.loads(path.read_text())
+    assert after["config"]["seed"] == 1
+    assert after["methods"]["1nn-dtw-band"]["fit_seconds"] == before["1nn-dtw-band"]["fit_seconds"]
+    assert after["methods"]["dba"]["fit_seconds"] != before["dba"]["fit_seconds"]

@@ -18,7 +18,12 @@ For one dataset and each method:
    series to its class mean (the paper's averaging score; not for aeon's DBA) and
    ``barycenter`` = DTW of the unwarped series to its class mean;
 3. classification: nearest class mean by DTW for every test series (``1nn-dtw``: aeon's
-   1-nearest-neighbour DTW classifier instead), keeping predictions and distances;
+   1-nearest-neighbour DTW classifier instead, squared point costs and no band;
+   ``1nn-dtw-band``: the archive's "DTW, learned window" baseline, 1-NN DTW with squared
+   point costs in the Sakoe-Chiba band of the default classifier's candidates, 0, 0.05,
+   0.1, 0.2 or none, that classifies the training series best by leave-one-out, ties to
+   the narrower band; computed with sk_rtw's exact nearest-neighbour search), keeping
+   predictions and distances;
 4. paired t-tests (scipy ``ttest_rel``, alpha = 0.05) between every pair of methods: on
    the per-training-series ``alignment`` values (the same series under both methods;
    lower is better) and on the per-test-series classification outcome (1 correct,
@@ -47,7 +52,8 @@ from pathlib import Path
 import numpy as np
 from scipy import stats
 
-from sk_rtw import Alignment, RTWNearestCentroid, dtw_pairwise_distance
+from sk_rtw import Alignment, RTWNearestCentroid, dtw_nearest_distance, dtw_pairwise_distance
+from sk_rtw.estimators._selection import WINDOWS
 from sk_rtw.utils import to_aeon
 
 from .._shared import method_object
@@ -81,7 +87,9 @@ ESTIMATOR_METHODS: dict[str, tuple[str, dict, str, dict]] = {
 }
 #: Rows of the classifier a user gets by default.
 DEFAULT_CLASSIFIERS = tuple(m for m in ESTIMATOR_METHODS if m.endswith("-default"))
-REFERENCE_METHODS = ("aeon-dba", "1nn-dtw")
+REFERENCE_METHODS = ("aeon-dba", "1nn-dtw", "1nn-dtw-band")
+#: Rows that do not depend on the seed: ``--resume`` keeps them when only the seed changed.
+SEED_FREE = ("1nn-dtw", "1nn-dtw-band")
 ALL_METHODS = (*ESTIMATOR_METHODS, *REFERENCE_METHODS)
 #: The main job's rows: the paper's one-mean comparison, the default classifier and the
 #: references (``rtw-paper`` is slow: means of length N T with the network at every time
@@ -101,6 +109,7 @@ class RunConfig:
     time_budget: float | None = None
     out: str = "results/ucr"
     verbose: int = 1
+    resume: bool = False
 
 
 def atomic_write_json(path: Path, payload: dict) -> None:
@@ -225,6 +234,33 @@ def _fit_1nn(train, test, config):
     }
 
 
+def _fit_1nn_band(train, test, config):
+    """1-NN DTW (squared point costs) in the band with the best leave-one-out accuracy."""
+    classes, codes = np.unique(train.y, return_inverse=True)
+    start = time.perf_counter()
+    scores = {}
+    for window in WINDOWS:
+        held_out = dtw_nearest_distance(
+            train.X, train.X, codes, window=window, squared=True,
+            exclude=np.arange(len(codes)), nearest_only=True,
+        )  # fmt: skip
+        scores[window] = float((held_out.argmin(1) == codes).mean())
+    best = max(scores.values())
+    window = next(w for w in WINDOWS if scores[w] == best)  # the narrowest of the best
+    fit_seconds = time.perf_counter() - start
+    start = time.perf_counter()
+    nearest = dtw_nearest_distance(test.X, train.X, codes, window=window, squared=True,
+                                   nearest_only=True)  # fmt: skip
+    return {
+        "fit_seconds": fit_seconds,
+        "predict_seconds": time.perf_counter() - start,
+        "predictions": classes[nearest.argmin(1)],
+        "classes": classes,
+        "dtw_window": window,
+        "selection": {"leave-one-out accuracy": {str(w): a for w, a in scores.items()}},
+    }
+
+
 def paired_test(a: np.ndarray, b: np.ndarray, lower_is_better: bool) -> dict:
     """Paired t-test of per-item values of methods A and B; which one is better."""
     mask = np.isfinite(a) & np.isfinite(b)
@@ -297,11 +333,45 @@ def warm_up(methods) -> None:
             _WARM.add(method)
 
 
+#: The run settings an estimator row's result depends on (a seed-free row: only the
+#: subsampling, and the seed when there is one).
+RESULT_SETTINGS = ("epochs", "max_series_per_class", "output_length", "device", "seed")
+
+
+def reusable(record: dict | None, config: RunConfig) -> dict:
+    """The finished method entries of a dataset's earlier ``record`` that this run would
+    compute the same way (``--resume``): every row when the run settings are the same,
+    the seed-free rows (:data:`SEED_FREE`) also across seeds when nothing is subsampled."""
+    if not record or record.get("error") is not None:
+        return {}
+    before, now = record.get("config", {}), asdict(config)
+    same = all(before.get(k) == now[k] for k in RESULT_SETTINGS)
+    same_split = before.get("max_series_per_class") == now["max_series_per_class"] and (
+        now["max_series_per_class"] is None or before.get("seed") == now["seed"]
+    )
+    return {
+        method: entry
+        for method, entry in record.get("methods", {}).items()
+        if method in config.methods
+        and "accuracy" in entry
+        and (same or (method in SEED_FREE and same_split))
+    }
+
+
+def read_record(path: Path) -> dict | None:
+    """A dataset's result file, or None if there is none (or it cannot be read)."""
+    try:
+        return json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+
+
 def _process_dataset(name, config, position, on_method_done) -> dict:
     warm_up(config.methods)
     start = time.perf_counter()
     record = {"dataset": name, "config": asdict(config), "methods": {}, "error": None}
     path = Path(config.out) / "datasets" / f"{name}.json"
+    done = reusable(read_record(path), config) if config.resume else {}
     try:
         train = load_split(name, "train", config.data_dir)
         test = load_split(name, "test", config.data_dir)
@@ -317,6 +387,10 @@ def _process_dataset(name, config, position, on_method_done) -> dict:
         )
         train = take(train, kept)
         for method in config.methods:
+            if method in done:  # finished by an earlier run with the same settings
+                record["methods"][method] = done[method]
+                on_method_done(method)
+                continue
             elapsed = time.perf_counter() - start
             if config.time_budget and elapsed > config.time_budget:
                 record["methods"][method] = {
@@ -332,6 +406,8 @@ def _process_dataset(name, config, position, on_method_done) -> dict:
                     out = _fit_aeon_dba(train, test, config)
                 elif method == "1nn-dtw":
                     out = _fit_1nn(train, test, config)
+                elif method == "1nn-dtw-band":
+                    out = _fit_1nn_band(train, test, config)
                 else:
                     raise ValueError(f"unknown method {method!r}")
             except Exception as exc:  # one method failing must not lose the others
@@ -340,12 +416,14 @@ def _process_dataset(name, config, position, on_method_done) -> dict:
                     "traceback": traceback.format_exc(),
                 }
                 _log(config, f"{position} {name}: {method} failed: {exc}")
+                atomic_write_json(path, record)
                 on_method_done(method)
                 continue
             correct = (np.asarray(out["predictions"]) == test.y).astype(int)
             out["correct"] = correct
             out["accuracy"] = float(correct.mean())
             record["methods"][method] = out
+            atomic_write_json(path, record)  # a long dataset keeps its finished methods
             _log(
                 config,
                 f"{position} {name}: {method} accuracy {out['accuracy']:.3f} "

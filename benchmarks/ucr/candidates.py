@@ -1,21 +1,27 @@
 """How the default classifier's choice rule was chosen: every candidate, and rules on the halves.
 
-For every dataset, every candidate of the choice (Sakoe-Chiba band x centroids per class)
-is fitted as a fixed classifier, ``RTWNearestCentroid(method=M, dtw_window=w,
-n_centroids=k)``, and scored on the test split; the same candidates' leave-one-out
-nearest-medoid outcomes on the training split (what the choice sees) are computed from one
-DTW matrix per band. Rules are then compared per half of the archive by the test accuracy
-of the candidate each picks, against 1-NN DTW (squared point costs and no band, as aeon's
-``KNeighborsTimeSeriesClassifier`` of the UCR benchmark): fixed candidates,
-the best leave-one-out score, and a prior kept unless a candidate is better by ``z``
-standard errors (the default's rule, :mod:`sk_rtw.estimators._selection`).
+For every dataset, every candidate of the choice (Sakoe-Chiba band x centroids of every
+class: one, or a fraction of the class up to every series) is fitted as a fixed
+classifier, ``RTWNearestCentroid(method=M, dtw_window=w, n_centroids=k)``, and scored on
+the test split; the candidates' leave-one-out nearest-medoid outcomes on the training
+split (what the choice sees, on the same stratified sample of a large training set) come
+from :func:`sk_rtw.estimators._selection.held_out_scores`. Rules are then compared per
+half (A and B of the development archive, C1 and C2 of the large training sets) by the
+test accuracy of the candidate each picks, against 1-NN DTW with squared point costs and
+no band (the predictions of aeon's ``KNeighborsTimeSeriesClassifier``, computed here with
+sk_rtw's exact nearest-neighbour search): fixed candidates, the best leave-one-out score,
+and priors kept unless a candidate is better by ``z`` standard errors (the default's
+rule, :mod:`sk_rtw.estimators._selection`).
 
 Example::
 
     python benchmarks/ucr/candidates.py --data-dir ../shared/ucr --all --methods rtw dba
+    python benchmarks/ucr/candidates.py --data-dir ../shared/ucr_large \\
+        --datasets Crop Computers AllGestureWiimoteX --methods dba
 
 Per-dataset results go to ``--out`` (default ``results/candidates``, one JSON file each,
-reused when present); the tables are printed at the end.
+reused when present, so runs over several data directories share one report); the tables
+are printed at the end for every dataset in ``--out``.
 """
 
 from __future__ import annotations
@@ -23,6 +29,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -31,35 +38,56 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the repository; 
 
 from benchmarks._shared import check_writable, existing_directory
 from benchmarks.ucr._data import available_datasets, load_split
-from benchmarks.ucr._summary import split_halves
-from sk_rtw import RTWNearestCentroid, dtw_pairwise_distance
-from sk_rtw.estimators._medoids import loo_class_distances
-from sk_rtw.estimators._selection import mcnemar
-
-BANDS = (0.0, 0.05, 0.1, 0.2, None)
-CENTROIDS = (1, 2, 4, 8, 16)
+from benchmarks.ucr._summary import halves
+from sk_rtw import RTWNearestCentroid, dtw_nearest_distance, dtw_pairwise_distance
+from sk_rtw.estimators._selection import (
+    CENTROIDS,
+    WINDOWS,
+    class_partitions,
+    held_out_scores,
+    mcnemar,
+    selection_sample,
+)
+from sk_rtw.utils import check_series_collection
 
 
 def key(window, k) -> str:
-    return f"{window}|{k}"
+    return f"{window}|{k!r}"
+
+
+def parse(candidate: str):
+    window, k = candidate.split("|")
+    return (None if window == "None" else float(window)), (float(k) if "." in k else int(k))
 
 
 def measure(name: str, data_dir: str, methods, seed: int) -> dict:
     """Test accuracy of every candidate per method, leave-one-out outcomes, 1-NN DTW."""
     train, test = load_split(name, "train", data_dir), load_split(name, "test", data_dir)
     classes, codes = np.unique(train.y, return_inverse=True)
-    record: dict = {"dataset": name, "loo": {}, "test": {m: {} for m in methods}}
-    for window in BANDS:
-        D = dtw_pairwise_distance(train.X, window=window)
+    collection = check_series_collection(train.X)
+    sample = selection_sample(collection, codes, WINDOWS, np.random.RandomState(seed))
+    subset, sampled = collection.subset(sample), codes[sample]
+    members = [np.flatnonzero(sampled == c) for c in range(len(classes))]
+    record: dict = {"dataset": name, "n_train": len(codes), "n_sample": len(sample),
+                    "loo": {}, "test": {m: {} for m in methods},
+                    "seconds": {m: {} for m in methods}}  # fmt: skip
+    for window in WINDOWS:
+        matrices = [dtw_pairwise_distance(subset.subset(m), window=window) for m in members]
         for k in CENTROIDS:
-            held_out = loo_class_distances(D, codes, len(classes), k)
-            record["loo"][key(window, k)] = (held_out.argmin(1) == codes).astype(int).tolist()
+            partition = class_partitions(matrices, members, k)
+            held_out = held_out_scores(subset, sampled, partition, window, every_class=False)
+            record["loo"][key(window, k)] = (held_out.argmin(1) == sampled).astype(int).tolist()
             for method in methods:
+                start = time.perf_counter()
                 clf = RTWNearestCentroid(method=method, dtw_window=window, n_centroids=k,
                                          random_state=seed).fit(train.X, train.y)  # fmt: skip
+                fit = time.perf_counter() - start
                 record["test"][method][key(window, k)] = clf.score(test.X, test.y)
-    nearest = dtw_pairwise_distance(test.X, train.X, squared=True).argmin(1)  # aeon's 1-NN
-    record["1nn"] = float((train.y[nearest] == test.y).mean())
+                predict = time.perf_counter() - start - fit
+                record["seconds"][method][key(window, k)] = [fit, predict]
+            print(f"{name}: {key(window, k)} done", file=sys.stderr, flush=True)
+    by_class = dtw_nearest_distance(test.X, train.X, codes, squared=True)
+    record["1nn"] = float((classes[by_class.argmin(1)] == test.y).mean())
     return record
 
 
@@ -75,37 +103,37 @@ def prior_rule(loo: dict, prior: str, z: float, grid) -> str:
 
 
 def order(candidate: str):
-    window, k = candidate.split("|")
-    return int(k), 2.0 if window == "None" else float(window)
+    window, k = parse(candidate)
+    count = k - 1e6 if isinstance(k, int) else k
+    return count, 2.0 if window is None else window
 
 
 def report(records: list[dict], method: str) -> list[str]:
-    names = sorted(r["dataset"] for r in records)
-    by_name = {r["dataset"]: r for r in records}
-    halves = dict(zip(("A", "B"), split_halves(names), strict=True))
-    grid = [key(w, k) for w in BANDS if w is not None for k in CENTROIDS if k <= 8]
-    fixed = [key(w, k) for w, k in ((0.05, 16), (0.05, 8), (0.1, 8), (0.05, 4))]
-    rules = {f"fixed w={c.replace('|', ', k=')}": (lambda r, c=c: c) for c in fixed}
+    by_name = {r["dataset"]: r for r in records if method in r["test"]}
+    parts = halves(sorted(by_name))
+    grid = [key(w, k) for w in WINDOWS for k in CENTROIDS]
+    rules = {f"fixed w={c.replace('|', ', k=')}": (lambda r, c=c: c) for c in grid}
     rules["best leave-one-out score"] = lambda r: max(
         grid, key=lambda c: (np.mean(r["loo"][c]), tuple(-x for x in order(c)))
     )
-    for prior in (key(0.05, 8), key(0.1, 8)):
-        for z in (0.5, 1.0, 1.5):
+    for prior in grid:
+        for z in (1.0, 2.0):
             rules[f"prior {prior.replace('|', ', k=')}, z={z}"] = lambda r, p=prior, z=z: (
                 prior_rule(r["loo"], p, z, grid)
             )
     lines = [f"\n{method}: test accuracy of the candidate each rule picks, minus 1-NN DTW "
              "(points), and datasets at least as accurate as 1-NN DTW",
-             "| rule | half A | half B |", "| --- | --- | --- |"]  # fmt: skip
+             "| rule | " + " | ".join(f"half {h}" for h in parts) + " |",
+             "| --- | " + " | ".join("---" for _ in parts) + " |"]  # fmt: skip
     for label, rule in rules.items():
         cells = []
-        for half in ("A", "B"):
-            picked = [by_name[n]["test"][method][rule(by_name[n])] for n in halves[half]]
-            nearest = [by_name[n]["1nn"] for n in halves[half]]
+        for names in parts.values():
+            picked = [by_name[n]["test"][method][rule(by_name[n])] for n in names]
+            nearest = [by_name[n]["1nn"] for n in names]
             diff = 100 * (np.mean(picked) - np.mean(nearest))
             wins = sum(a >= b - 1e-12 for a, b in zip(picked, nearest, strict=True))
             cells.append(f"{diff:+.2f} ({wins}/{len(picked)})")
-        lines.append(f"| {label} | {cells[0]} | {cells[1]} |")
+        lines.append(f"| {label} | " + " | ".join(cells) + " |")
     return lines
 
 
@@ -125,7 +153,6 @@ def main(argv=None) -> None:
     args = parser.parse_args(argv)
     out = check_writable(args.out, directory=True)
     names = args.datasets or available_datasets(args.data_dir)
-    records = []
     for name in names:
         path = out / f"{name}.json"
         record = json.loads(path.read_text()) if path.is_file() else None
@@ -133,7 +160,7 @@ def main(argv=None) -> None:
             record = measure(name, args.data_dir, args.methods, args.seed)
             path.write_text(json.dumps(record))
             print(f"{name}: done", file=sys.stderr, flush=True)
-        records.append(record)
+    records = [json.loads(p.read_text()) for p in sorted(out.glob("*.json"))]
     for method in args.methods:
         print("\n".join(report(records, method)))
 

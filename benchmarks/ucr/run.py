@@ -35,9 +35,12 @@ Results (``--out``, default ``results/ucr``)::
     accuracy_scatter.png    RTW against TTW/NTW/DBA accuracy per dataset
     critical_difference.png aeon's critical-difference diagram of the accuracies
 
-``--resume`` skips datasets whose file exists without an error, so an interrupted run
-loses at most the datasets in progress. A dataset (or a method) that fails is recorded
-with its error and the run goes on.
+A dataset's file is written again after each of its methods. ``--resume`` keeps every
+method already there that was computed with the same settings (the seed-free 1-NN rows
+whatever the seed, so ``cp -r`` of one seed's results and ``--resume --seed 1`` computes
+only what depends on the seed), and skips datasets with nothing left: an interrupted run
+loses at most the method in progress. A dataset (or a method) that fails is recorded with
+its error and the run goes on.
 """
 
 from __future__ import annotations
@@ -75,6 +78,8 @@ from benchmarks.ucr._protocol import (
     DEFAULT_METHODS,
     RunConfig,
     process_dataset,
+    read_record,
+    reusable,
 )
 from benchmarks.ucr._summary import (
     critical_difference_plot,
@@ -174,7 +179,9 @@ def parse_args(argv=None) -> argparse.Namespace:
     parser.add_argument(
         "--resume",
         action="store_true",
-        help="skip datasets whose result file in --out exists without an error",
+        help="keep every method already in a dataset's result file (written after each "
+        "method) that was computed with the same settings, and compute the rest; the "
+        "1-NN rows are kept across seeds",
     )
     loud = parser.add_mutually_exclusive_group()
     loud.add_argument(
@@ -211,16 +218,11 @@ def select_datasets(args) -> list[str]:
     return list(AEON_BUNDLED)
 
 
-def finished(out: Path, name: str) -> bool:
-    import json
-
-    path = out / "datasets" / f"{name}.json"
-    if not path.is_file():
-        return False
-    try:
-        return json.loads(path.read_text()).get("error") is None
-    except ValueError:
-        return False
+def finished(out: Path, name: str, config: RunConfig) -> bool:
+    """Whether ``--resume`` has nothing left to do for a dataset: every requested method
+    is in its result file, computed with this run's settings."""
+    record = read_record(out / "datasets" / f"{name}.json")
+    return set(reusable(record, config)) == set(config.methods)
 
 
 def progress_bar(n_datasets: int, n_methods: int, enabled: bool):
@@ -291,7 +293,6 @@ def main(argv=None) -> int:
             file=sys.stderr,
         )
         return 1
-    todo = [n for n in names if not (args.resume and finished(out, n))]
     config = RunConfig(
         methods=tuple(args.methods),
         data_dir=args.data_dir,
@@ -303,7 +304,9 @@ def main(argv=None) -> int:
         time_budget=args.time_budget,
         out=str(out),
         verbose=0 if args.quiet else 1 + args.verbose,
+        resume=args.resume,
     )
+    todo = [n for n in names if not (args.resume and finished(out, n, config))]
     print(
         f"{len(names)} dataset(s), {len(names) - len(todo)} already done; methods "
         f"{', '.join(args.methods)}; {args.epochs} epochs; results in {out}",
