@@ -388,3 +388,27 @@ def test_1nn_with_a_learned_band_and_a_resume_across_seeds(tmp_path, capsys):
     assert after["config"]["seed"] == 1
     assert after["methods"]["1nn-dtw-band"]["fit_seconds"] == before["1nn-dtw-band"]["fit_seconds"]
     assert after["methods"]["dba"]["fit_seconds"] != before["dba"]["fit_seconds"]
+
+
+def test_the_seeds_report_gives_every_target_per_half_and_seed(tmp_path, capsys):
+    """Two runs that differ in the seed: each target once per half, seeds in order, the
+    1-NN rows reused by --resume; the choice counted the same when it is."""
+    import shutil
+
+    from benchmarks.ucr import seeds
+
+    args = ["--datasets", "ItalyPowerDemand", "GunPoint", "--methods", "rtw", "rtw-default",
+            "1nn-dtw", "1nn-dtw-band", "--epochs", "2", "--quiet"]  # fmt: skip
+    assert main([*args, "--out", str(tmp_path / "s0")]) == 0
+    shutil.copytree(tmp_path / "s0", tmp_path / "s1")
+    assert main([*args, "--out", str(tmp_path / "s1"), "--seed", "1", "--resume"]) == 0
+    capsys.readouterr()
+    seeds.main([str(tmp_path / "s0"), str(tmp_path / "s1"), "--combine", "all=A+B"])
+    printed = capsys.readouterr().out
+    assert "Seeds 0, 1" in printed
+    assert "| target | half A (1) | half B (1) | half all (2) |" in printed
+    record = json.loads((tmp_path / "s0" / "datasets" / "GunPoint.json").read_text())
+    default = f"{record['methods']['rtw-default']['accuracy']:.4f}"
+    row = next(line for line in printed.splitlines() if line.startswith("| mean accuracy, def"))
+    assert row.split(" | ")[1].startswith(default)  # half A is GunPoint (alphabetically first)
+    assert "| the same choice on every seed (datasets) | 1 / 1 | 1 / 1 | 2 / 2 |" in printed
