@@ -308,8 +308,8 @@ def test_the_cell_budget_bounds_the_sample():
         collection, codes, _selection.WINDOWS, np.random.RandomState(0)
     )
     pair = sum(_selection.band_cells(1000, w) for w in _selection.WINDOWS)
-    same_class = sum(np.sum(codes[index] == c) ** 2 / 2 for c in (0, 1))  # pairs per band
-    assert same_class * pair <= 1.01 * _selection.CELLS_PER_POINT * X.size
+    cells = len(index) ** 2 / 2 * pair
+    assert cells <= _selection.CELLS_PER_POINT * X.size
     assert len(index) < 400
     assert _selection.band_cells(100, None) == 100**2
     assert _selection.band_cells(100, 0.0) == 100
@@ -382,3 +382,23 @@ def test_large_classes_are_split_in_chunks(monkeypatch):
     assert np.all(np.bincount(groups) >= 1)
     np.testing.assert_array_equal(_selection._apportion(5, np.array([7, 7, 6])), [2, 2, 1])
     np.testing.assert_array_equal(_selection._apportion(3, np.array([4, 3, 3])), [1, 1, 1])
+
+
+def test_a_sampled_class_is_split_on_its_completed_matrix(monkeypatch):
+    """The pairs the choice computed are reused: the completed matrix equals the class's
+    whole DTW matrix, so the parts are those of a fresh k-medoids."""
+    monkeypatch.setattr(_selection, "MAX_SERIES", 14)
+    X, y = two_shapes_per_class(n=20)
+    collection = check_series_collection(X)
+    selection = _selection.choose(collection, y, 0.1, 0.25, random_state=0)
+    assert selection.report["sampled"]
+    for c in (0, 1):
+        members = np.flatnonzero(y == c)
+        seen = np.flatnonzero(np.isin(members, selection.sample))
+        completed = _selection._complete(collection, members, (seen, selection.matrices[c]),
+                                         0.1, None)  # fmt: skip
+        whole = dtw_pairwise_distance(X[members], window=0.1)
+        np.testing.assert_allclose(completed, whole, rtol=1e-12)
+    groups, owners = _selection.partition(collection, y, 0.25, 0.1, selection=selection)
+    np.testing.assert_array_equal(np.bincount(owners), [5, 3])
+    np.testing.assert_array_equal(owners[groups], y)

@@ -63,10 +63,21 @@ def query_envelope(x, ny, window, lower, upper):
     value over that run (a monotone-deque sliding minimum and maximum, ``O(T_x + ny)``
     per coordinate).
     """
+    nx = x.shape[0]
+    scratch = np.empty(4 * nx + 2 * ny, dtype=np.int64)
+    _envelope(x, ny, window, lower, upper, scratch)
+
+
+@njit(cache=True, nogil=True)
+def _envelope(x, ny, window, lower, upper, scratch):
+    """:func:`query_envelope` in ``scratch`` (at least ``4 T_x + 2 ny`` integers): no
+    allocation, for a search that computes one envelope per reference length."""
     nx, p = x.shape
     lo, hi = _kernels.sakoe_chiba_rows(nx, ny, window)
-    first = np.empty(ny, dtype=np.int64)  # a_j: the first row whose range reaches j
-    last = np.empty(ny, dtype=np.int64)  # b_j: the last row whose range starts at or before j
+    first = scratch[:ny]  # a_j: the first row whose range reaches j
+    last = scratch[ny : 2 * ny]  # b_j: the last row whose range starts at or before j
+    low_queue = scratch[2 * ny : 2 * ny + nx]
+    high_queue = scratch[2 * ny + nx : 2 * ny + 2 * nx]
     i = 0
     for j in range(ny):
         while hi[i] <= j:
@@ -77,8 +88,6 @@ def query_envelope(x, ny, window, lower, upper):
         while lo[i] > j:
             i -= 1
         last[j] = i
-    low_queue = np.empty(nx, dtype=np.int64)
-    high_queue = np.empty(nx, dtype=np.int64)
     for k in range(p):
         low_head, low_tail, high_head, high_tail = 0, 0, 0, 0
         pushed = 0  # rows [0, pushed) have entered the queues
@@ -173,6 +182,7 @@ def nearest_by_class(
         x = Q[q, : lq[q]]
         lower = np.empty((R.shape[1], p))
         upper = np.empty((R.shape[1], p))
+        scratch = np.empty(4 * lq[q] + 2 * R.shape[1], dtype=np.int64)
         candidates = np.empty(n_r, dtype=np.int64)
         bounds = np.empty(n_r)
         available = np.zeros(n_classes, dtype=np.bool_)
@@ -183,7 +193,7 @@ def nearest_by_class(
                 continue
             if lr[r] != current:
                 current = lr[r]
-                query_envelope(x, current, window, lower, upper)
+                _envelope(x, current, window, lower, upper, scratch)
             candidates[n] = r
             bounds[n] = lb_keogh(R[r, : lr[r]], lower, upper, segments, squared)
             available[owners[r]] = True

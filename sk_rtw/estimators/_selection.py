@@ -23,7 +23,7 @@ Everything is computed once and scored many times:
 
 The criterion is deterministic (no folds to draw), so the choice does not depend on
 ``random_state`` unless the training set is sampled. On more than :data:`MAX_SERIES`
-series, or when the class matrices would exceed :data:`CELLS_PER_POINT` DTW cells per
+series, or when every pair of them would exceed :data:`CELLS_PER_POINT` DTW cells per
 training sample, the choice is made on a stratified random sample
 (``selection_["n_series"]``); a fraction then applies to the full classes. Finally
 (:func:`partition`) every class is split into its count of parts by k-medoids (on the
@@ -61,8 +61,8 @@ PRIOR: tuple[float | None, int | float] = (None, 0.25)
 Z_THRESHOLD = 1.0
 #: Most training series the choice is made on (a stratified sample beyond).
 MAX_SERIES = 1000
-#: DTW cells of the choice's class matrices per sample of the training set (sum of the
-#: series lengths).
+#: DTW cells of the choice per sample of the training set (sum of the series lengths):
+#: every pair of the sampled series once per band, about the work of one plain fit.
 CELLS_PER_POINT = 40_000
 #: Largest class split into centroids by one k-medoids; larger ones are split in chunks.
 PART_SERIES = 500
@@ -109,6 +109,9 @@ class Selection:
         Leave-one-out distance of every sampled series to every class under the chosen
         candidate (what the probability temperature is fitted on); ``inf`` for the class
         of a series that is alone in it.
+    matrices : list of ndarray
+        Per class, the DTW matrix of its sampled series in the chosen band (what
+        :func:`partition` completes for a class scored in part).
     """
 
     dtw_window: float | None
@@ -117,6 +120,7 @@ class Selection:
     sample: np.ndarray
     medoids: dict[tuple[Any, Any], list[np.ndarray]] = field(default_factory=dict)
     held_out: np.ndarray = field(default_factory=lambda: np.empty((0, 0)))
+    matrices: list[np.ndarray] = field(default_factory=list)
 
 
 def band_cells(length: float, window: float | None) -> float:
@@ -130,16 +134,17 @@ def selection_sample(
     collection: SeriesCollection, codes: np.ndarray, windows, rng: np.random.RandomState
 ) -> np.ndarray:
     """Indices of the series the choice is made on: all of them, or a stratified sample
-    within :data:`MAX_SERIES` and the :data:`CELLS_PER_POINT` budget of the class
-    matrices (every class keeps at least two series, or all it has)."""
+    within :data:`MAX_SERIES` and the :data:`CELLS_PER_POINT` budget (every pair of the
+    sample once in every band: the class matrices and the searches together); every
+    class keeps at least two series, or all it has."""
     n = collection.n_series
     lengths = collection.lengths
     sizes = np.bincount(codes)
     pair = sum(band_cells(float(np.mean(lengths)), w) for w in windows)
     budget = CELLS_PER_POINT * float(lengths.sum())
-    # a sample of m series holds about m^2 sum(p_c^2) / 2 pairs of the same class
-    same_class = float(np.sum((sizes / n) ** 2))
-    size = int(min(n, MAX_SERIES, np.sqrt(2.0 * budget / max(pair * same_class, 1.0))))
+    # the class matrices hold the pairs of the same class, the searches reach the others:
+    # about the work of every pair of the sample once
+    size = int(min(n, MAX_SERIES, np.sqrt(2.0 * budget / max(pair, 1.0))))
     if size >= n:
         return np.arange(n)
     keep = []
@@ -422,7 +427,8 @@ def choose(
             flush=True,
         )
     medoids = {q: partition.labels for q, partition in partitions.items()}
-    return Selection(chosen[0], chosen[1], report, sample, medoids, held_out)
+    return Selection(chosen[0], chosen[1], report, sample, medoids, held_out,
+                     matrices[chosen[0]])  # fmt: skip
 
 
 def partition(
@@ -440,7 +446,8 @@ def partition(
     A class of one part needs no DTW, nor does one whose every series is a part. A class
     the selection scored whole reuses its k-medoids; another is split on the DTW matrix
     (band ``window``) of its series, in random chunks of at most :data:`PART_SERIES`
-    series (each with its share of the parts) when it is larger.
+    series (each with its share of the parts) when it is larger; the pairs the selection
+    computed (a sampled class in the selection's band) are not computed again.
 
     Returns
     -------
@@ -467,7 +474,11 @@ def partition(
         elif reused is not None and len(reused[c]) == len(members):
             part = reused[c]  # the selection's sample holds the whole class, in order
         else:
-            part = _split(collection, members, k, window, rng, n_jobs)
+            known = None
+            if selection is not None and selection.matrices and selection.dtw_window == window:
+                seen = np.flatnonzero(np.isin(members, selection.sample))
+                known = (seen, selection.matrices[c])
+            part = _split(collection, members, k, window, rng, n_jobs, known)
         groups[members] = len(owners) + part
         owners += [c] * k
     return groups, np.asarray(owners, dtype=np.int64)
@@ -480,9 +491,14 @@ def _split(
     window: float | None,
     rng: np.random.RandomState,
     n_jobs: int | None,
+    known: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> np.ndarray:
-    """k-medoids labels of one class, in chunks of at most :data:`PART_SERIES` series."""
+    """k-medoids labels of one class, in chunks of at most :data:`PART_SERIES` series;
+    ``known``: positions among ``members`` and their DTW matrix, reused for one chunk."""
     n_chunks = math.ceil(len(members) / PART_SERIES)
+    if n_chunks == 1 and known is not None:
+        _, labels = class_medoids(_complete(collection, members, known, window, n_jobs), k)
+        return labels
     order = np.arange(len(members)) if n_chunks == 1 else rng.permutation(len(members))
     chunks = np.array_split(order, n_chunks)
     shares = _apportion(k, np.array([len(chunk) for chunk in chunks]))
@@ -495,6 +511,29 @@ def _split(
         part[np.sort(chunk)] = offset + labels
         offset += int(share)
     return part
+
+
+def _complete(
+    collection: SeriesCollection,
+    members: np.ndarray,
+    known: tuple[np.ndarray, np.ndarray],
+    window: float | None,
+    n_jobs: int | None,
+) -> np.ndarray:
+    """The DTW matrix of ``members`` from the block ``known`` holds: only the pairs with
+    a series outside it are computed."""
+    seen, block = known
+    rest = np.setdiff1d(np.arange(len(members)), seen)
+    D = np.empty((len(members), len(members)))
+    D[np.ix_(seen, seen)] = block
+    if len(rest):
+        outside = collection.subset(members[rest])
+        cross = dtw_pairwise_distance(outside, collection.subset(members[seen]),
+                                      window=window, n_jobs=n_jobs)  # fmt: skip
+        D[np.ix_(rest, seen)] = cross
+        D[np.ix_(seen, rest)] = cross.T
+        D[np.ix_(rest, rest)] = dtw_pairwise_distance(outside, window=window, n_jobs=n_jobs)
+    return D
 
 
 def _apportion(k: int, sizes: np.ndarray) -> np.ndarray:
