@@ -10,7 +10,7 @@ import pytest
 
 from benchmarks.ucr._data import load_split
 from benchmarks.ucr._protocol import paired_test
-from benchmarks.ucr._summary import HALF_C1, HALF_C2, halves
+from benchmarks.ucr._summary import HALF_A, HALF_B, HALF_C1, HALF_C2, halves
 from benchmarks.ucr.run import main
 from sk_rtw import RTWNearestCentroid, dtw_pairwise_distance
 from sk_rtw.estimators._selection import CENTROIDS, PRIOR, WINDOWS
@@ -291,12 +291,12 @@ def test_default_rows_make_the_same_choice_and_the_halves_report_adds_up(tmp_pat
         assert len(one["output_length"]) == record["n_classes"]
     summary = (out / "summary.md").read_text().split("## Halves")[1]
     assert (
-        "Half A: alphabetical positions 1, 3, 5, ... of the other datasets (ArrowHead, "
-        "ItalyPowerDemand); Half B: 2, 4, 6, ... (GunPoint)" in summary
+        "Half A: the development archive's alphabetical positions 1, 3, 5, ... (ArrowHead, "
+        "GunPoint); Half B: 2, 4, 6, ... (ItalyPowerDemand)" in summary
     )
     row = next(line for line in summary.splitlines() if line.startswith("| dba | 0"))
     half_a = np.mean(
-        [records[n]["methods"]["dba"]["accuracy"] for n in ("ArrowHead", "ItalyPowerDemand")]
+        [records[n]["methods"]["dba"]["accuracy"] for n in ("ArrowHead", "GunPoint")]
     )
     assert row.split(" | ")[1] == f"{half_a:.4f} (n=2)"
     pair = next(
@@ -343,11 +343,17 @@ def test_the_candidates_benchmark_scores_every_candidate_and_the_prior_rule(tmp_
 def test_the_halves_of_the_archive_and_of_the_large_training_sets():
     names = ["Beef", "ArrowHead", "Crop", "Computers", "Coffee", "ElectricDevices"]
     assert halves(names) == {
-        "A": ["ArrowHead", "Coffee"],
-        "B": ["Beef"],
+        "A": ["ArrowHead", "Beef", "Coffee"],  # the archive's fixed halves
         "C1": ["Computers", "Crop"],
         "C2": ["ElectricDevices"],
     }
+    assert halves(["Zeta", "Alpha", "Beta", "BME"]) == {
+        "A": ["Alpha", "Zeta"],  # other datasets: alphabetical positions 1, 3, ...
+        "B": ["BME", "Beta"],
+    }
+    # the fixed halves of the development archive are its alphabetical halves
+    archive = sorted(HALF_A + HALF_B)
+    assert (archive[0::2], archive[1::2]) == (list(HALF_A), list(HALF_B))
     assert not set(HALF_C1) & set(HALF_C2) and len(HALF_C1) == len(HALF_C2) == 3
 
 
@@ -410,5 +416,5 @@ def test_the_seeds_report_gives_every_target_per_half_and_seed(tmp_path, capsys)
     record = json.loads((tmp_path / "s0" / "datasets" / "GunPoint.json").read_text())
     default = f"{record['methods']['rtw-default']['accuracy']:.4f}"
     row = next(line for line in printed.splitlines() if line.startswith("| mean accuracy, def"))
-    assert row.split(" | ")[1].startswith(default)  # half A is GunPoint (alphabetically first)
+    assert row.split(" | ")[1].startswith(default)  # half A holds GunPoint
     assert "| the same choice on every seed (datasets) | 1 / 1 | 1 / 1 | 2 / 2 |" in printed
