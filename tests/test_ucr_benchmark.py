@@ -409,6 +409,11 @@ def test_the_seeds_report_gives_every_target_per_half_and_seed(tmp_path, capsys)
     shutil.copytree(tmp_path / "s0", tmp_path / "s1")
     assert main([*args, "--out", str(tmp_path / "s1"), "--seed", "1", "--resume"]) == 0
     capsys.readouterr()
+    # a dataset only a baseline ran on (no default row) is left out, not a KeyError
+    baseline_only = json.loads((tmp_path / "s0" / "datasets" / "GunPoint.json").read_text())
+    baseline_only["dataset"] = "ArrowHead"
+    baseline_only["methods"] = {"1nn-dtw": baseline_only["methods"]["1nn-dtw"]}
+    (tmp_path / "s0" / "datasets" / "ArrowHead.json").write_text(json.dumps(baseline_only))
     seeds.main([str(tmp_path / "s0"), str(tmp_path / "s1"), "--combine", "all=A+B"])
     printed = capsys.readouterr().out
     assert "Seeds 0, 1" in printed
@@ -417,4 +422,4 @@ def test_the_seeds_report_gives_every_target_per_half_and_seed(tmp_path, capsys)
     default = f"{record['methods']['rtw-default']['accuracy']:.4f}"
     row = next(line for line in printed.splitlines() if line.startswith("| mean accuracy, def"))
     assert row.split(" | ")[1].startswith(default)  # half A holds GunPoint
-    assert "| the same choice on every seed (datasets) | 1 / 1 | 1 / 1 | 2 / 2 |" in printed
+    assert "| the same choice on every seed (datasets) | 1 of 1 | 1 of 1 | 2 of 2 |" in printed

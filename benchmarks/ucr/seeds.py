@@ -8,7 +8,7 @@ development archive; C1, C2 of the large training sets; ``--combine`` adds union
 with a learned band), the datasets where the default is at least as accurate, the fit
 against one RTW mean per class, the median prediction speed-up over full-window 1-NN
 DTW, and the datasets whose choice is the same on every seed. Cells list the seeds in
-the order given (one value when all agree).
+the order given, separated by semicolons (one value when all agree).
 
 Example::
 
@@ -32,11 +32,14 @@ DEFAULT, ONE_MEAN, NEAREST, LEARNED = "rtw-default", "rtw", "1nn-dtw", "1nn-dtw-
 
 
 def by_seed(folders: list[str]) -> dict[int, dict[str, dict]]:
-    """Records by seed and dataset (folders of the same seed are merged)."""
+    """Records by seed and dataset (folders of the same seed are merged).
+
+    Records without the default row (a dataset that only a baseline ran on) are left out.
+    """
     out: dict[int, dict[str, dict]] = {}
     for folder in folders:
         for record in load_records(Path(folder)):
-            if record.get("error") is None:
+            if record.get("error") is None and DEFAULT in record.get("methods", {}):
                 out.setdefault(record["config"]["seed"], {})[record["dataset"]] = record
     return out
 
@@ -46,7 +49,7 @@ def _accuracy(record: dict, method: str) -> float:
 
 
 def cell(values: list[str]) -> str:
-    return values[0] if len(set(values)) == 1 else " / ".join(values)
+    return values[0] if len(set(values)) == 1 else "; ".join(values)
 
 
 def rows(records: dict[int, dict[str, dict]], names: list[str]) -> list[tuple[str, str]]:
@@ -68,7 +71,7 @@ def rows(records: dict[int, dict[str, dict]], names: list[str]) -> list[tuple[st
         out.append((f"default minus {label} (points)", cell(gap)))
         wins = [
             f"{sum(_accuracy(r, DEFAULT) >= _accuracy(r, reference) - 1e-12 for r in rs)}"
-            f" / {len(rs)}"
+            f" of {len(rs)}"
             for rs in per_seed
         ]
         out.append((f"default at least as accurate as {label}", cell(wins)))
@@ -80,7 +83,7 @@ def rows(records: dict[int, dict[str, dict]], names: list[str]) -> list[tuple[st
         ]
         total = sum(r["methods"][DEFAULT]["fit_seconds"] for r in rs)
         one = sum(r["methods"][ONE_MEAN]["fit_seconds"] for r in rs)
-        fits.append(f"{total:.0f} s / {one:.0f} s; max {max(ratios):.1f}x")
+        fits.append(f"{total:.0f} s / {one:.0f} s, max {max(ratios):.1f}x")
     out.append(("fit: default / one RTW mean per class (total; worst dataset)", cell(fits)))
     speed = [
         f"{np.median([_predict_ratio(r) for r in rs]):.1f}x" for rs in per_seed
@@ -95,7 +98,7 @@ def rows(records: dict[int, dict[str, dict]], names: list[str]) -> list[tuple[st
         for n in names
     }  # fmt: skip
     same = sum(len(c) == 1 for c in choices.values())
-    out.append(("the same choice on every seed (datasets)", f"{same} / {len(names)}"))
+    out.append(("the same choice on every seed (datasets)", f"{same} of {len(names)}"))
     return out
 
 
@@ -118,7 +121,7 @@ def choices_table(records: dict[int, dict[str, dict]], names: list[str]) -> list
         if not entries:
             continue
         picks = [
-            f"{e['methods'][DEFAULT]['dtw_window']}, {e['methods'][DEFAULT]['n_centroids']!r}"
+            f"({e['methods'][DEFAULT]['dtw_window']}, {e['methods'][DEFAULT]['n_centroids']!r})"
             for e in entries
         ]
         counts = [
@@ -172,7 +175,10 @@ def main(argv=None) -> None:
     seeds = ", ".join(str(s) for s in sorted(records))
     table = {label: dict(rows(records, found)) for label, found in parts.items() if found}
     labels = list(next(iter(table.values())))
-    print(f"Seeds {seeds} (cells list them in this order; one value when all agree)\n")
+    print(
+        f"Seeds {seeds} (cells list them in this order, separated by semicolons; "
+        "one value when all agree)\n"
+    )
     print("| target | " + " | ".join(f"half {h} ({len(parts[h])})" for h in table) + " |")
     print("| --- | " + " | ".join("---" for _ in table) + " |")
     for label in labels:
