@@ -4,6 +4,8 @@ Usage::
 
     python benchmarks/classifier_scale.py                      # both sizes
     python benchmarks/classifier_scale.py --sets electricdevices --methods rtw dba
+    python benchmarks/classifier_scale.py --sets handoutlines --methods rtw \
+        --n-centroids 8 --nn-test 0                 # 8 per class instead of the default
 
 The archive's largest training sets are not shipped here, so this script makes synthetic
 sets of their sizes: ``electricdevices`` (8,926 training series of 96 samples, 7 classes)
@@ -15,8 +17,10 @@ Prints, per set and method: the fit seconds of the classifier a user gets by def
 (``RTWNearestCentroid(method=...)``: band and centroids chosen from a sample of the
 training set, then every centroid averaged) and of one mean per class
 (``n_centroids=1, dtw_window=None``), their ratio, the choice's seconds, its sample size
-and result, test accuracy and prediction seconds; and 1-NN DTW (sk_rtw's DTW, no band)
-on the first ``--nn-test`` test series, its seconds scaled to the whole test set.
+and result, test accuracy and prediction seconds; with ``--n-centroids``, the same for
+the classifier with those numbers of centroids instead (``auto``: the default; the band
+is still chosen); and 1-NN DTW (sk_rtw's DTW, no band) on the first ``--nn-test`` test
+series (0: skipped), its seconds scaled to the whole test set.
 """
 
 from __future__ import annotations
@@ -30,7 +34,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the repository; then _shared
 
-from benchmarks._shared import machine, positive_int
+from benchmarks._shared import machine, non_negative_int, positive_int
 from sk_rtw import RTWNearestCentroid, dtw_pairwise_distance
 
 #: (training series, test series, samples, classes) of each synthetic set.
@@ -61,6 +65,24 @@ def make_set(n_train: int, n_test: int, length: int, n_classes: int, seed: int =
     return X[:n_train], labels[:n_train], X[n_train:], labels[n_train:]
 
 
+def centroids(text: str) -> int | float | str:
+    """An ``n_centroids`` value from the command line: "auto", an integer or a fraction."""
+    if text == "auto":
+        return text
+    try:
+        return positive_int(text)
+    except argparse.ArgumentTypeError:
+        try:
+            value = float(text)
+        except ValueError:
+            value = float("nan")
+        if not 0.0 < value <= 1.0:
+            raise argparse.ArgumentTypeError(
+                f"{text!r} is not auto, an integer >= 1 or a fraction in (0, 1]"
+            ) from None
+        return value
+
+
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(
         description=__doc__.splitlines()[0],
@@ -69,8 +91,12 @@ def main(argv=None) -> None:
     )
     parser.add_argument("--sets", nargs="+", choices=list(SETS), default=list(SETS))
     parser.add_argument("--methods", nargs="+", choices=["rtw", "dba"], default=["rtw", "dba"])
-    parser.add_argument("--nn-test", type=positive_int, default=20,
-                        help="test series 1-NN DTW classifies (default 20)")  # fmt: skip
+    parser.add_argument("--nn-test", type=non_negative_int, default=20,
+                        help="test series 1-NN DTW classifies (default 20; 0: none)")  # fmt: skip
+    parser.add_argument("--n-centroids", nargs="+", type=centroids, default=["auto"],
+                        help="rows beside one mean per class: these n_centroids (auto, the "
+                        "default; an integer per class; a fraction), the band still "
+                        "chosen")  # fmt: skip
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args(argv)
     print(f"machine: {machine()}, one thread per fit")
@@ -81,8 +107,10 @@ def main(argv=None) -> None:
               f"classes, {n_test} test series", flush=True)  # fmt: skip
         for method in args.methods:
             seconds = {}
-            for label, params in (("one mean", {"n_centroids": 1, "dtw_window": None}),
-                                  ("default", {})):  # fmt: skip
+            rows = [("one mean", {"n_centroids": 1, "dtw_window": None})]
+            rows += [("default", {}) if k == "auto" else (f"k={k}", {"n_centroids": k})
+                     for k in args.n_centroids]  # fmt: skip
+            for label, params in rows:
                 clf = RTWNearestCentroid(method=method, random_state=args.seed, **params)
                 start = time.perf_counter()
                 clf.fit(X, y)
@@ -98,8 +126,11 @@ def main(argv=None) -> None:
                              f"series: dtw_window={clf.dtw_window_}, "
                              f"n_centroids={clf.n_centroids_}")  # fmt: skip
                 print(line, flush=True)
-            ratio = seconds["default"] / seconds["one mean"]
-            print(f"  {method} default / one mean fit: {ratio:.2f}x", flush=True)
+            for label in [label for label in seconds if label != "one mean"]:
+                ratio = seconds[label] / seconds["one mean"]
+                print(f"  {method} {label} / one mean fit: {ratio:.2f}x", flush=True)
+        if args.nn_test <= 0:
+            continue
         start = time.perf_counter()
         subset = slice(0, args.nn_test)
         nearest = dtw_pairwise_distance(X_test[subset], X).argmin(1)

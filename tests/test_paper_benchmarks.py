@@ -182,3 +182,23 @@ def test_the_clustering_benchmark_classifies_manifold_demonstrations(monkeypatch
     assert cells[0] == "1.000"  # default RTW separates the arcs
     assert line.count("w=") == 2 and line.count("k=") == 2
     assert float(cells[-1]) == 1.0  # 1-NN DTW
+
+
+def test_the_scale_benchmark_adds_rows_for_given_centroids_and_checks_them(monkeypatch, capsys):
+    """benchmarks/classifier_scale.py on a tiny set: one row per --n-centroids value (auto:
+    the default) with its ratio to one mean per class, no 1-NN line at --nn-test 0, bad
+    values refused."""
+    from benchmarks import classifier_scale
+
+    monkeypatch.setattr(classifier_scale, "SETS", {"handoutlines": (24, 8, 40, 2)})
+    classifier_scale.main(["--sets", "handoutlines", "--methods", "dba",
+                           "--n-centroids", "auto", "2", "0.5", "--nn-test", "0"])  # fmt: skip
+    out = capsys.readouterr().out
+    assert "dba      k=2: fit" in out and "dba    k=0.5: fit" in out
+    assert "dba k=2 / one mean fit" in out and "dba k=0.5 / one mean fit" in out
+    assert "dba  default: fit" in out and "dba default / one mean fit" in out
+    assert "1-NN DTW" not in out
+    for bad in ("0", "1.5", "many"):
+        with pytest.raises(SystemExit):
+            classifier_scale.main(["--n-centroids", bad])
+        assert "is not auto, an integer >= 1 or a fraction in (0, 1]" in capsys.readouterr().err
