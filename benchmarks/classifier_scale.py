@@ -6,6 +6,8 @@ Usage::
     python benchmarks/classifier_scale.py --sets electricdevices --methods rtw dba
     python benchmarks/classifier_scale.py --sets handoutlines --methods rtw \
         --n-centroids 8 --nn-test 0                 # 8 per class instead of the default
+    python benchmarks/classifier_scale.py --sets handoutlines --methods rtw \
+        --n-centroids 8 --dtw-window 0.05 --nn-test 0   # ... and a band of 5%
 
 The archive's largest training sets are not shipped here, so this script makes synthetic
 sets of their sizes: ``electricdevices`` (8,926 training series of 96 samples, 7 classes)
@@ -18,9 +20,9 @@ Prints, per set and method: the fit seconds of the classifier a user gets by def
 training set, then every centroid averaged) and of one mean per class
 (``n_centroids=1, dtw_window=None``), their ratio, the choice's seconds, its sample size
 and result, test accuracy and prediction seconds; with ``--n-centroids``, the same for
-the classifier with those numbers of centroids instead (``auto``: the default; the band
-is still chosen); and 1-NN DTW (sk_rtw's DTW, no band) on the first ``--nn-test`` test
-series (0: skipped), its seconds scaled to the whole test set.
+the classifier with those numbers of centroids instead (``auto``: the default), the band
+chosen unless ``--dtw-window`` fixes it; and 1-NN DTW (sk_rtw's DTW, no band) on the
+first ``--nn-test`` test series (0: skipped), its seconds scaled to the whole test set.
 """
 
 from __future__ import annotations
@@ -83,6 +85,19 @@ def centroids(text: str) -> int | float | str:
         return value
 
 
+def window(text: str) -> float | str | None:
+    """A ``dtw_window`` value from the command line: "auto", "none" or a fraction."""
+    if text in ("auto", "none"):
+        return None if text == "none" else text
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not 0.0 <= value <= 1.0:
+        raise argparse.ArgumentTypeError(f"{text!r} is not auto, none or a fraction in [0, 1]")
+    return value
+
+
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(
         description=__doc__.splitlines()[0],
@@ -96,7 +111,10 @@ def main(argv=None) -> None:
     parser.add_argument("--n-centroids", nargs="+", type=centroids, default=["auto"],
                         help="rows beside one mean per class: these n_centroids (auto, the "
                         "default; an integer per class; a fraction), the band still "
-                        "chosen")  # fmt: skip
+                        "chosen unless --dtw-window is given")  # fmt: skip
+    parser.add_argument("--dtw-window", type=window, default="auto",
+                        help="band of the --n-centroids rows: auto (chosen, the default), "
+                        "none or a fraction of the length")  # fmt: skip
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args(argv)
     print(f"machine: {machine()}, one thread per fit")
@@ -108,7 +126,10 @@ def main(argv=None) -> None:
         for method in args.methods:
             seconds = {}
             rows = [("one mean", {"n_centroids": 1, "dtw_window": None})]
-            rows += [("default", {}) if k == "auto" else (f"k={k}", {"n_centroids": k})
+            band = {} if args.dtw_window == "auto" else {"dtw_window": args.dtw_window}
+            suffix = "" if not band else f", band {args.dtw_window}"
+            rows += [("default" + suffix, band) if k == "auto"
+                     else (f"k={k}{suffix}", {"n_centroids": k, **band})
                      for k in args.n_centroids]  # fmt: skip
             for label, params in rows:
                 clf = RTWNearestCentroid(method=method, random_state=args.seed, **params)

@@ -202,3 +202,20 @@ def test_the_scale_benchmark_adds_rows_for_given_centroids_and_checks_them(monke
         with pytest.raises(SystemExit):
             classifier_scale.main(["--n-centroids", bad])
         assert "is not auto, an integer >= 1 or a fraction in (0, 1]" in capsys.readouterr().err
+
+
+def test_the_scale_benchmark_fixes_the_band_of_its_rows_when_asked(monkeypatch, capsys):
+    """--dtw-window fixes the band of the --n-centroids rows (no choice runs: the row
+    prints none) and is refused outside auto, none and [0, 1]."""
+    from benchmarks import classifier_scale
+
+    monkeypatch.setattr(classifier_scale, "SETS", {"handoutlines": (24, 8, 40, 2)})
+    classifier_scale.main(["--sets", "handoutlines", "--methods", "dba", "--n-centroids",
+                           "2", "--dtw-window", "0.1", "--nn-test", "0"])  # fmt: skip
+    rows = [line for line in capsys.readouterr().out.splitlines() if "k=2, band 0.1" in line]
+    assert len(rows) == 2 and "fit" in rows[0] and "choice" not in rows[0]
+    assert "k=2, band 0.1 / one mean fit" in rows[1]
+    for bad in ("-0.1", "1.5", "wide"):
+        with pytest.raises(SystemExit):
+            classifier_scale.main(["--dtw-window", bad])
+        assert "is not auto, none or a fraction in [0, 1]" in capsys.readouterr().err
