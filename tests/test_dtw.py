@@ -204,12 +204,14 @@ def test_invalid_normalize_and_bad_series():
         dtw_distance(np.ones((4, 3)), np.ones((4, 3)), SPD(2))
 
 
-def test_product_without_distance_segments_uses_general_path():
-    M = Product((Sphere(2), SPD(2)))
-    assert M.distance_segments is None
+def test_product_without_kernel_distance_uses_general_path():
+    from sk_rtw.dtw._kernels import segment_codes
+
+    M = Product((Sphere(2), SPD(4)))  # SPD(4) has no closed-form kernel
+    assert segment_codes(M) is None
     rng = np.random.default_rng(0)
     X = np.concatenate(
-        [Sphere(2).random_point((3, 6), rng), SPD(2).random_point((3, 6), rng).reshape(3, 6, 4)],
+        [Sphere(2).random_point((3, 6), rng), SPD(4).random_point((3, 6), rng).reshape(3, 6, 16)],
         axis=-1,
     )
     D = dtw_pairwise_distance(X, manifold=M)

@@ -219,3 +219,15 @@ def test_the_scale_benchmark_fixes_the_band_of_its_rows_when_asked(monkeypatch, 
         with pytest.raises(SystemExit):
             classifier_scale.main(["--dtw-window", bad])
         assert "is not auto, none or a fraction in [0, 1]" in capsys.readouterr().err
+
+
+def test_the_spd_speed_benchmark_prints_each_manifold_against_r3(capsys):
+    """benchmarks/spd_speed.py's DTW section: one row per manifold, R^3 the 1.0x row."""
+    from benchmarks import spd_speed
+
+    spd_speed.main(["--sections", "dtw", "--repeats", "1"])
+    rows = [line for line in capsys.readouterr().out.splitlines() if "x R^3" in line]
+    assert [row.split(":")[0].strip() for row in rows] == [
+        "Euclidean(dim=3)", "SPD(dim=2)", "SPD(dim=3)", "SPD(dim=8)"
+    ]
+    assert rows[0].endswith("1.0x R^3")

@@ -35,7 +35,7 @@ import torch
 
 from ..dtw import check_window, medoid_index, path_indices
 from ..dtw._band import coarse_collection, multiscale_path, solved_exactly
-from ..dtw._kernels import matched_positions, segment_codes
+from ..dtw._kernels import kernel_points, matched_positions, segment_codes
 from ..manifolds import Manifold
 from ..utils import SeriesCollection
 from ._layout import GroupLayout
@@ -280,10 +280,14 @@ def _path_warps(
     ]  # fmt: skip
     warps: list[np.ndarray] = [np.empty(0)] * len(series)
     if exact:
+        lengths = stacked[1][exact]
+        # padding read as the last sample (on the manifold), then the kernels' form
+        last = np.minimum(np.arange(stacked[0].shape[1]), lengths[:, None] - 1)
+        padded = np.take_along_axis(stacked[0][exact], last[:, :, None], axis=1)
         positions = matched_positions(
-            _stack(references), np.array([len(r) for r in references]),
-            np.ascontiguousarray(stacked[0][exact]), stacked[1][exact],
-            codes[exact], segments, True, band,
+            kernel_points(manifold, _stack(references)), np.array([len(r) for r in references]),
+            np.ascontiguousarray(kernel_points(manifold, padded)), lengths, codes[exact],
+            segments, True, band,
         )  # fmt: skip
         for row, n in enumerate(exact):
             length = len(references[codes[n]])
@@ -299,8 +303,10 @@ def _path_warps(
 
 
 def _stack(arrays: list[np.ndarray]) -> np.ndarray:
-    """The references (a few) as one zero-padded ``(G, L_max, p)`` float64 array."""
-    out = np.zeros((len(arrays), max(len(a) for a in arrays), int(np.prod(arrays[0].shape[1:]))))
+    """The references (a few) as one ``(G, L_max, p)`` float64 array, padded by repeating
+    each one's last sample (padding stays on the manifold)."""
+    out = np.empty((len(arrays), max(len(a) for a in arrays), int(np.prod(arrays[0].shape[1:]))))
     for k, a in enumerate(arrays):
         out[k, : len(a)] = a.reshape(len(a), -1)
+        out[k, len(a) :] = out[k, len(a) - 1]
     return out

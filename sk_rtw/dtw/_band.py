@@ -168,7 +168,9 @@ def _band_costs(x, y, lo, hi, manifold, squared) -> np.ndarray:
     width = int((hi - lo).max())
     segments = _kernels.segment_codes(manifold)
     if segments is not None:
-        return band_segment_costs(_flat(x), _flat(y), lo, hi, segments, squared, width)
+        return band_segment_costs(_kernels.kernel_points(manifold, _flat(x)),
+                                  _kernels.kernel_points(manifold, _flat(y)), lo, hi, segments,
+                                  squared, width)  # fmt: skip
     rows = np.repeat(np.arange(len(x)), hi - lo)
     offsets = np.arange(rows.size) - np.repeat(np.cumsum(hi - lo) - (hi - lo), hi - lo)
     cols = lo[rows] + offsets
@@ -244,8 +246,10 @@ def guide_bound(
         guide = multiscale_path(x, y, manifold, squared)[0]
     if guide is None:
         return np.inf
-    cost = _kernels.path_cost(_flat(x), _flat(y), np.asarray(guide, dtype=np.int64), segments,
-                              squared)  # fmt: skip
+    cost = _kernels.path_cost(
+        _kernels.kernel_points(manifold, _flat(x)), _kernels.kernel_points(manifold, _flat(y)),
+        np.asarray(guide, dtype=np.int64), segments, squared,
+    )  # fmt: skip
     return cost * (1.0 + GUIDE_SLACK)
 
 

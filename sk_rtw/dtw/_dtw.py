@@ -73,8 +73,8 @@ def point_cost_matrix(
     if segments is not None:
         out = np.empty((len(x), len(y)))
         _kernels.segment_cost_matrix(
-            _flat(x),
-            _flat(y),
+            _kernels.kernel_points(manifold, _flat(x)),
+            _kernels.kernel_points(manifold, _flat(y)),
             len(x),
             len(y),
             segments,
@@ -211,7 +211,8 @@ def dtw_distance(
     # two rows of memory; long pairs without a band skip the cells that cannot beat their
     # coarse-to-fine path (the same value)
     bound = guide_bound(x, y, manifold, w, squared)
-    fx, fy = _flat(x), _flat(y)
+    fx = _kernels.kernel_points(manifold, _flat(x))
+    fy = _kernels.kernel_points(manifold, _flat(y))
     value = _kernels.pruned_distance(fx, fy, segments, squared, w, bound)
     if not value <= bound:
         value = _kernels.pruned_distance(fx, fy, segments, squared, w, np.inf)
@@ -308,8 +309,8 @@ def _pairwise(
     manifold = cx.manifold
     segments = _kernels.segment_codes(manifold)
     if segments is not None:
-        flat_x = np.ascontiguousarray(cx.data.reshape(cx.n_series, cx.max_length, -1))
-        flat_y = np.ascontiguousarray(cy.data.reshape(cy.n_series, cy.max_length, -1))
+        flat_x = _kernels.kernel_series(cx)
+        flat_y = _kernels.kernel_series(cy)
         if not per_step:
             bounds = _guide_bounds(cx, cy, window, squared, symmetric)
             return _kernels.pairwise_segments(

@@ -9,8 +9,11 @@ it and store only what they compute (:func:`_pruned_row`): the result is the sam
 Point distances that numba computes itself are described by "segments" ``(start, stop,
 code)`` of a flattened point, translated by :func:`segment_codes` from the manifold's
 :attr:`~sk_rtw.manifolds.Manifold.distance_segments`: code 0 Euclidean, 1 great-circle on
-a sphere, 2 sign-invariant great circle (quaternions); a product space is several
-segments, combined as ``sqrt(sum d_s^2)``.
+a sphere, 2 sign-invariant great circle (quaternions), 3 and 4 affine-invariant SPD(2)
+and SPD(3) (:mod:`~sk_rtw.dtw._spd_kernels`); a product space is several segments,
+combined as ``sqrt(sum d_s^2)``. The kernels read points in their kernel form
+(:func:`kernel_points`): the coordinates as they are, except an SPD block, which becomes
+its features (prepared once per point, so that a pair costs no eigendecomposition).
 """
 
 from __future__ import annotations
@@ -21,6 +24,7 @@ import numpy as np
 from numba import njit, prange
 
 from ..manifolds import Manifold
+from ._spd_kernels import FEATURE_WIDTH, spd_features, spd_squared_distance
 
 _INF = np.inf
 
@@ -28,19 +32,78 @@ _INF = np.inf
 SEGMENT_EUCLIDEAN = 0
 SEGMENT_SPHERE = 1
 SEGMENT_SIGN_INVARIANT_SPHERE = 2
+SEGMENT_SPD2 = 3
+SEGMENT_SPD3 = 4
 SEGMENT_CODES = {
     "euclidean": SEGMENT_EUCLIDEAN,
     "sphere": SEGMENT_SPHERE,
     "sign-invariant sphere": SEGMENT_SIGN_INVARIANT_SPHERE,
 }
+#: SPD(k) blocks with a kernel form: their size ``k * k``, their code and ``k``.
+_SPD_BLOCKS = {4: (SEGMENT_SPD2, 2), 9: (SEGMENT_SPD3, 3)}
+
+
+def _layout(manifold: Manifold) -> list[tuple[int, int, int, int, int]] | None:
+    """Every segment as ``(start, stop, kernel start, kernel stop, code)``: where it lies
+    in the flat point and in its kernel form; None if one has no kernel distance."""
+    segments = manifold.distance_segments
+    if segments is None:
+        return None
+    rows, offset = [], 0
+    for start, stop, kind in segments:
+        if kind == "spd" and stop - start in _SPD_BLOCKS:
+            code, k = _SPD_BLOCKS[stop - start]
+            width = FEATURE_WIDTH[k]
+        elif kind in SEGMENT_CODES:
+            code, width = SEGMENT_CODES[kind], stop - start
+        else:
+            return None
+        rows.append((start, stop, offset, offset + width, code))
+        offset += width
+    return rows
 
 
 def segment_codes(manifold: Manifold) -> np.ndarray | None:
-    """``(n_segments, 3)`` int64 ``(start, stop, code)`` rows, or None (no kernel form)."""
-    segments = manifold.distance_segments
-    if segments is None or any(kind not in SEGMENT_CODES for _, _, kind in segments):
+    """``(n_segments, 3)`` int64 ``(start, stop, code)`` rows of the kernel form of a point
+    (:func:`kernel_points`), or None (no kernel form: the manifold's ``pairwise_dist``)."""
+    rows = _layout(manifold)
+    if rows is None:
         return None
-    return np.array([(a, b, SEGMENT_CODES[kind]) for a, b, kind in segments], dtype=np.int64)
+    return np.array([(a, b, code) for _, _, a, b, code in rows], dtype=np.int64)
+
+
+def kernel_points(manifold: Manifold, flat: np.ndarray) -> np.ndarray:
+    """Flat points ``(..., p)`` (validated) in the kernels' form: unchanged (the same
+    array) unless the manifold has SPD blocks, which become their features."""
+    rows = _layout(manifold)
+    if rows is None or all(code < SEGMENT_SPD2 for *_, code in rows):
+        return flat
+    lead = flat.shape[:-1]
+    points = np.ascontiguousarray(flat, dtype=np.float64).reshape(-1, flat.shape[-1])
+    out = np.empty((points.shape[0], rows[-1][3]))
+    for start, stop, a, b, code in rows:
+        if code >= SEGMENT_SPD2:
+            k = 2 if code == SEGMENT_SPD2 else 3
+            features = spd_features(np.ascontiguousarray(points[:, start:stop]), k)
+            bad = ~np.isfinite(features).all(1)
+            if bad.any():
+                point = points[int(np.argmax(bad)), start:stop].reshape(k, k)
+                raise ValueError(
+                    f"the SPD({k}) point {point.tolist()} has no Cholesky factor in float64 "
+                    "(it is not positive definite, or too close to singular); regularise "
+                    "it (add a multiple of the identity)"
+                )
+            out[:, a:b] = features
+        else:
+            out[:, a:b] = points[:, start:stop]
+    return out.reshape(*lead, out.shape[-1])
+
+
+def kernel_series(collection) -> np.ndarray:
+    """A :class:`~sk_rtw.utils.SeriesCollection`'s padded series ``(n, T, p)`` in the
+    kernels' form, C-contiguous."""
+    flat = collection.data.reshape(collection.n_series, collection.max_length, -1)
+    return np.ascontiguousarray(kernel_points(collection.manifold, flat))
 
 
 @njit(cache=True, nogil=True)
@@ -255,6 +318,9 @@ def _robust_distance(xi, yj, segments):
         if code == SEGMENT_EUCLIDEAN:
             for k in range(start, stop):
                 scale, ssq = _accumulate_scaled(xi[k] - yj[k], scale, ssq)
+        elif code >= SEGMENT_SPD2:  # log-eigenvalues are at most ~745: no overflow
+            spd = math.sqrt(spd_squared_distance(xi, yj, start, code - SEGMENT_SPD2 + 2))
+            scale, ssq = _accumulate_scaled(spd, scale, ssq)
         else:
             dot = 0.0
             for k in range(start, stop):
@@ -298,6 +364,9 @@ def _cost_row(x, y, i, ny, segments, squared, row):
                     diff = xi[k] - y[j, k]
                     sq += diff * diff
                 row[j] += sq
+        elif code >= SEGMENT_SPD2:
+            for j in range(ny):
+                row[j] += spd_squared_distance(xi, y[j], start, code - SEGMENT_SPD2 + 2)
         else:
             for j in range(ny):
                 dot = 0.0

@@ -75,7 +75,8 @@ def path_indices(
         return optimal_path(point_cost_matrix(x, y, manifold, squared), window)
     # the point costs are computed inside the accumulation (the T_x x T_y cost matrix is
     # never stored) and only where a path could still beat the guide's cost
-    fx, fy = _flat(x), _flat(y)
+    fx = _kernels.kernel_points(manifold, _flat(x))
+    fy = _kernels.kernel_points(manifold, _flat(y))
     bound = guide_bound(x, y, manifold, window, squared, guide)
     rows = _kernels.accumulated_segment_cost(fx, fy, segments, squared, window, bound)
     cost = _kernels.ragged_value(*rows, len(x) - 1, len(y) - 1)

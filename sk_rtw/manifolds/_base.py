@@ -26,7 +26,7 @@ EXTREME_EXPONENT = 100
 
 #: Kinds of point distance a block of coordinates can have (see
 #: :attr:`Manifold.distance_segments`).
-DISTANCE_KINDS = ("euclidean", "sphere", "sign-invariant sphere")
+DISTANCE_KINDS = ("euclidean", "sphere", "sign-invariant sphere", "spd")
 
 
 def checked_geometry(points=(), vectors=(), broadcast=True):
@@ -125,11 +125,13 @@ class Manifold(ABC):
         """The geodesic distance as ``(start, stop, kind)`` blocks of the flat point.
 
         ``kind`` is one of :data:`DISTANCE_KINDS`: Euclidean distance, great-circle
-        distance, or the sign-invariant great circle of unit quaternions; the distance of
-        a point is ``sqrt(sum_s d_s^2)`` over the blocks. None when the distance has no
-        such form (SPD): computations that need it (the DTW kernels) then use
-        :meth:`pairwise_dist`. A statement about the geometry only: how a consumer
-        computes these distances is its own business.
+        distance, the sign-invariant great circle of unit quaternions, or the
+        affine-invariant distance of a row-major SPD matrix; the distance of a point is
+        ``sqrt(sum_s d_s^2)`` over the blocks. None when the distance has no such form:
+        computations that need it (the DTW kernels) then use :meth:`pairwise_dist`, as
+        they do for the kinds they have no kernel for (SPD matrices larger than 3 x 3).
+        A statement about the geometry only: how a consumer computes these distances is
+        its own business.
         """
         return None
 

@@ -43,6 +43,10 @@ class SPD(Manifold):
         return (self.dim, self.dim)
 
     @property
+    def distance_segments(self):
+        return ((0, self.dim * self.dim, "spd"),)
+
+    @property
     def intrinsic_dim(self) -> int:
         return self.dim * (self.dim + 1) // 2
 
@@ -81,7 +85,7 @@ class SPD(Manifold):
 
     def _dist(self, p, x):
         si = symmetric_function(p, "invsqrt")
-        return safe_norm(symmetric_function(si @ x @ si, "log"), dim=(-2, -1))
+        return _log_eigenvalue_norm(si @ x @ si)
 
     def _norm(self, p, v):
         si = symmetric_function(p, "invsqrt")
@@ -91,7 +95,7 @@ class SPD(Manifold):
         # Whiten each point of A once, not once per pair.
         si = symmetric_function(A, "invsqrt").unsqueeze(-3)
         inner = si @ B.unsqueeze(-4) @ si
-        return safe_norm(symmetric_function(inner, "log"), dim=(-2, -1))
+        return _log_eigenvalue_norm(inner)
 
     def extreme_scale(self, points):
         eigenvalues = np.linalg.eigvalsh(points)
@@ -167,3 +171,10 @@ class SPD(Manifold):
         w, U = np.linalg.eigh(p)
         root = (U * np.sqrt(w)[..., None, :]) @ np.swapaxes(U, -1, -2)
         return root @ s @ root
+
+
+def _log_eigenvalue_norm(S):
+    """``||logm(S)||_F`` of SPD matrices from their eigenvalues alone (no eigenvectors, no
+    reconstruction); its gradient, ``U diag(log(w) / w) U^T / ||.||``, has no
+    ``1 / (w_i - w_j)`` terms and stays finite for repeated eigenvalues."""
+    return safe_norm(torch.log(torch.linalg.eigvalsh(sym(S))), dim=-1)

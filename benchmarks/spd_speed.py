@@ -1,0 +1,148 @@
+"""SPD series next to R^3 series of the same shape: DTW, alignment and DBA, one run.
+
+Usage::
+
+    python benchmarks/spd_speed.py                       # about 2 minutes on one thread
+    python benchmarks/spd_speed.py --sections dtw --repeats 5
+    python benchmarks/spd_speed.py --sections rlasa --shared-data ../shared/data
+
+Prints, on one thread, the best of ``--repeats`` wall times (after a warm-up call) and
+their ratio to R^3 measured in the same run:
+
+``dtw``
+    ``dtw_pairwise_distance`` on 8 series of 200 samples (28 pairs, no band): R^3, SPD(2),
+    SPD(3) (closed-form kernel distances) and SPD(8) (eigenvalues of the whitened pair).
+``align``
+    ``sk_rtw.align`` with its defaults and ``dba_average`` on N = 30 series of T = 100
+    samples: R^3 and SPD(2).
+``rlasa``
+    ``RTWNearestCentroid()`` (defaults) on R-LASA's 30 shapes (``--shared-data``), the
+    first 3 demonstrations of each for training and the 4th for prediction, every 5th
+    sample (200): its SPD(2) version and its unit-quaternion version, one fit and one
+    prediction each (no repeats), and their ratio.
+
+Run it on an earlier commit (``PYTHONPATH`` set to that checkout) to compare before and
+after: every number comes from public calls.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import torch
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the repository; then _shared
+
+from benchmarks._shared import machine, positive_int
+from sk_rtw import RTWNearestCentroid, align, dtw_pairwise_distance
+from sk_rtw.baselines import dba_average
+from sk_rtw.manifolds import SPD, Euclidean
+
+SECTIONS = ("dtw", "align", "rlasa")
+
+
+def best_time(call, repeats: int) -> float:
+    """The least wall time of ``repeats`` calls, after one warm-up call."""
+    call()
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        call()
+        times.append(time.perf_counter() - start)
+    return min(times)
+
+
+def smooth_series(manifold, n_series: int, length: int, seed: int = 0) -> np.ndarray:
+    """Series that move smoothly on ``manifold``: a random start walked along random
+    tangent steps (``exp`` of a small step at every sample)."""
+    rng = np.random.default_rng(seed)
+    points = manifold.random_point(n_series, random_state=rng)
+    out = np.empty((n_series, length, *manifold.point_shape))
+    for t in range(length):
+        out[:, t] = points
+        step = np.stack([manifold.random_tangent(p, 0.05, random_state=rng) for p in points])
+        points = np.asarray(manifold.exp(points, step))
+    return out
+
+
+def dtw_rows(repeats: int) -> None:
+    print("\ndtw_pairwise_distance, 8 series of 200 samples, no band")
+    reference = None
+    for manifold in (Euclidean(3), SPD(2), SPD(3), SPD(8)):
+        X = smooth_series(manifold, 8, 200)
+        seconds = best_time(lambda X=X, m=manifold: dtw_pairwise_distance(X, manifold=m),
+                            repeats)  # fmt: skip
+        reference = reference or seconds
+        print(f"  {manifold!r:>14}: {seconds * 1e3:8.1f} ms, {seconds / reference:6.1f}x R^3",
+              flush=True)  # fmt: skip
+
+
+def align_rows(repeats: int) -> None:
+    print("\nN = 30 series of T = 100 samples")
+    for label, fit in (
+        ("align (default)", lambda X, m: align(X, manifold=m, random_state=0)),
+        ("dba_average", lambda X, m: dba_average(X, manifold=m)),
+    ):
+        reference = None
+        for manifold in (Euclidean(3), SPD(2)):
+            X = smooth_series(manifold, 30, 100)
+            seconds = best_time(lambda X=X, m=manifold, fit=fit: fit(X, m), repeats)
+            reference = reference or seconds
+            print(f"  {label} {manifold!r:>14}: {seconds:7.2f} s, {seconds / reference:6.1f}x "
+                  "R^3", flush=True)  # fmt: skip
+
+
+def rlasa_rows(shared_data: str) -> None:
+    from benchmarks.paper._data import data_dir, rlasa_quaternions, rlasa_shapes, rlasa_spd
+
+    root = data_dir(shared_data)
+    shapes = rlasa_shapes(root)
+    print(f"\nRTWNearestCentroid() on R-LASA: {len(shapes)} shapes, 3 demonstrations each "
+          "to fit, the 4th to predict, 200 samples")  # fmt: skip
+    seconds = {}
+    for name, load in (("quaternion", rlasa_quaternions), ("spd", rlasa_spd)):
+        demos = np.stack([load(root, shape)[:, ::5] for shape in shapes])
+        X, X_test = demos[:, :3].reshape(-1, *demos.shape[2:]), demos[:, 3]
+        y, y_test = np.repeat(np.arange(len(shapes)), 3), np.arange(len(shapes))
+        clf = RTWNearestCentroid(manifold=name, random_state=0)
+        start = time.perf_counter()
+        clf.fit(X, y)
+        fit = time.perf_counter() - start
+        start = time.perf_counter()
+        accuracy = clf.score(X_test, y_test)
+        predict = time.perf_counter() - start
+        seconds[name] = (fit, predict)
+        print(f"  {name:>10}: fit {fit:7.1f} s, prediction {predict:6.2f} s, accuracy "
+              f"{accuracy:.3f}", flush=True)  # fmt: skip
+    (fit_q, predict_q), (fit_s, predict_s) = seconds["quaternion"], seconds["spd"]
+    print(f"  spd / quaternion: fit {fit_s / fit_q:.1f}x, prediction {predict_s / predict_q:.1f}x")
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(
+        description=__doc__.splitlines()[0],
+        epilog=__doc__.split("Usage::")[1].split("Prints")[0],
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("--sections", nargs="+", choices=SECTIONS, default=list(SECTIONS))
+    parser.add_argument("--repeats", type=positive_int, default=3)
+    parser.add_argument("--shared-data", default=None,
+                        help="folder holding r_lasa/ (the rlasa section; default: the "
+                        "repository's ../shared/data)")  # fmt: skip
+    args = parser.parse_args(argv)
+    torch.set_num_threads(1)
+    print(f"machine: {machine()}, one thread")
+    if "dtw" in args.sections:
+        dtw_rows(args.repeats)
+    if "align" in args.sections:
+        align_rows(args.repeats)
+    if "rlasa" in args.sections:
+        rlasa_rows(args.shared_data)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,187 @@
+"""Affine-invariant SPD distances for the DTW kernels, in closed form for 2 x 2 and 3 x 3.
+
+``dist(A, B)^2 = sum_i log(lambda_i)^2`` over the eigenvalues of ``M = L^-1 B L^-T``
+(``A = L L^T``, Cholesky), the generalized eigenvalues of ``(B, A)``: no matrix function
+is needed, only eigenvalues. Each point is prepared once (:func:`spd_features`): its
+log-eigenvalues, the inverse of its Cholesky factor and its own upper triangle, so a
+pair costs one congruence ``L^-1 B L^-T`` and the eigenvalues of a symmetric 2 x 2
+(a quadratic) or 3 x 3 matrix (the trigonometric solution of its characteristic cubic,
+Smith 1961) -- no eigendecomposition, no LAPACK call per pair.
+
+Only largest eigenvalues are taken from a formula (a sum of positive terms: no
+cancellation); the smaller of two comes from the determinant (``det M = det B / det A``,
+known from the log-eigenvalues), the smallest of three as the inverse of the largest of
+the reverse pair ``(A, B)`` and the middle one from the determinant.
+
+The sorted log-eigenvalues are also a lower bound: ``||log lambda(A) - log lambda(B)||``
+is at most ``dist(A, B)`` (the sorted log-spectrum is 1-Lipschitz for the
+affine-invariant metric: Bhatia, *Positive Definite Matrices*, 2007, Thm 6.1.4 with the
+Hoffman-Wielandt inequality), so LB_Keogh over those coordinates bounds DTW from below.
+
+A flat SPD(k) point is ``k * k`` row-major entries; its features are, in order, the ``k``
+ascending log-eigenvalues, the ``k (k + 1) / 2`` entries of ``L^-1`` row by row (lower
+triangle) and the ``k (k + 1) / 2`` entries of the point row by row (upper triangle).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+#: Number of features of an SPD(k) point, for the sizes with a closed form.
+FEATURE_WIDTH = {2: 8, 3: 15}
+#: The same, indexed by ``k``, for the compiled code.
+FEATURE_WIDTH_ARRAY = np.array([0, 0, FEATURE_WIDTH[2], FEATURE_WIDTH[3]], dtype=np.int64)
+
+_TWO_THIRDS_PI = 2.0 * math.pi / 3.0
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _eigenvalues2(a, b, c):
+    """Eigenvalues ``(small, large)`` of ``[[a, b], [b, c]]`` (positive definite): the
+    large one from the quadratic (no cancellation), the small one from the determinant."""
+    mean = 0.5 * (a + c)
+    radius = math.hypot(0.5 * (a - c), b)
+    large = mean + radius
+    return (a * c - b * b) / large, large
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _largest3(m11, m12, m13, m22, m23, m33):
+    """Largest eigenvalue of a symmetric positive definite 3 x 3 matrix by the
+    trigonometric solution of its characteristic cubic (Smith 1961): ``q + 2 p cos(phi)``
+    with ``cos(phi) >= 1/2``, a sum of positive terms."""
+    q = (m11 + m22 + m33) / 3.0
+    d11, d22, d33 = m11 - q, m22 - q, m33 - q
+    p2 = d11 * d11 + d22 * d22 + d33 * d33 + 2.0 * (m12 * m12 + m13 * m13 + m23 * m23)
+    if p2 == 0.0:  # a multiple of the identity
+        return q
+    p = math.sqrt(p2 / 6.0)
+    det = (
+        d11 * (d22 * d33 - m23 * m23)
+        - m12 * (m12 * d33 - m23 * m13)
+        + m13 * (m12 * m23 - d22 * m13)
+    )
+    r = min(1.0, max(-1.0, 0.5 * det / (p * p * p)))  # det((M - q I) / p) / 2
+    return q + 2.0 * p * math.cos(math.acos(r) / 3.0)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _congruence3(i11, i21, i22, i31, i32, i33, b11, b12, b13, b22, b23, b33):
+    """Upper triangle of ``L^-1 B L^-T`` for a lower-triangular ``L^-1`` (rows) and a
+    symmetric ``B``."""
+    n11, n12, n13 = i11 * b11, i11 * b12, i11 * b13  # N = L^-1 B, row by row
+    n21 = i21 * b11 + i22 * b12
+    n22 = i21 * b12 + i22 * b22
+    n23 = i21 * b13 + i22 * b23
+    n31 = i31 * b11 + i32 * b12 + i33 * b13
+    n32 = i31 * b12 + i32 * b22 + i33 * b23
+    n33 = i31 * b13 + i32 * b23 + i33 * b33
+    return (
+        n11 * i11,
+        n11 * i21 + n12 * i22,
+        n11 * i31 + n12 * i32 + n13 * i33,
+        n21 * i21 + n22 * i22,
+        n21 * i31 + n22 * i32 + n23 * i33,
+        n31 * i31 + n32 * i32 + n33 * i33,
+    )
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _pair_largest3(x, y, s):
+    """Largest generalized eigenvalue of ``(B, A)``, ``A`` the point of ``x`` and ``B``
+    the point of ``y`` whose features start at ``s``."""
+    m11, m12, m13, m22, m23, m33 = _congruence3(
+        x[s + 3], x[s + 4], x[s + 5], x[s + 6], x[s + 7], x[s + 8],
+        y[s + 9], y[s + 10], y[s + 11], y[s + 12], y[s + 13], y[s + 14],
+    )  # fmt: skip
+    return _largest3(m11, m12, m13, m22, m23, m33)
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def spd_features(points, k):
+    """The features (module docstring) of flat SPD(k) points ``(n, k * k)``, ``k`` 2 or 3;
+    not finite for a point that is not positive definite in float64."""
+    n = points.shape[0]
+    out = np.empty((n, FEATURE_WIDTH_ARRAY[k]))
+    for t in range(n):
+        x = points[t]
+        f = out[t]
+        if k == 2:
+            a, b, c = x[0], 0.5 * (x[1] + x[2]), x[3]
+            small, large = _eigenvalues2(a, b, c)
+            f[0], f[1] = math.log(small), math.log(large)
+            l11 = math.sqrt(a)
+            l21 = b / l11
+            l22 = math.sqrt(small * large / a)  # c - b^2 / a without its cancellation
+            f[2] = 1.0 / l11
+            f[3] = -l21 / (l11 * l22)
+            f[4] = 1.0 / l22
+            f[5], f[6], f[7] = a, b, c
+        else:
+            a11, a22, a33 = x[0], x[4], x[8]
+            a12 = 0.5 * (x[1] + x[3])
+            a13 = 0.5 * (x[2] + x[6])
+            a23 = 0.5 * (x[5] + x[7])
+            l11 = math.sqrt(a11)
+            l21 = a12 / l11
+            l31 = a13 / l11
+            l22 = math.sqrt(a22 - l21 * l21)
+            l32 = (a23 - l31 * l21) / l22
+            l33 = math.sqrt(a33 - l31 * l31 - l32 * l32)
+            i11, i22, i33 = 1.0 / l11, 1.0 / l22, 1.0 / l33  # L^-1, row by row
+            i21 = -l21 * i11 * i22
+            i32 = -l32 * i22 * i33
+            i31 = -(l31 * i11 + l32 * i21) * i33
+            f[3], f[4], f[5], f[6], f[7], f[8] = i11, i21, i22, i31, i32, i33
+            # the largest eigenvalue of A and of A^-1 = L^-T L^-1, the middle one from
+            # the determinant
+            f[2] = math.log(_largest3(a11, a12, a13, a22, a23, a33))
+            f[0] = -math.log(_largest3(
+                i11 * i11 + i21 * i21 + i31 * i31, i21 * i22 + i31 * i32, i31 * i33,
+                i22 * i22 + i32 * i32, i32 * i33, i33 * i33,
+            ))  # fmt: skip
+            log_det = 2.0 * (math.log(l11) + math.log(l22) + math.log(l33))
+            f[1] = log_det - f[0] - f[2]
+            f[9], f[10], f[11], f[12], f[13], f[14] = a11, a12, a13, a22, a23, a33
+    return out
+
+
+
+@njit(cache=True, nogil=True, inline="always")
+def spd_log_eigenvalues2(x, y, s):
+    """Log generalized eigenvalues ``(large, small)`` of the pair of 2 x 2 points whose
+    features start at ``s`` in ``x`` and ``y``."""
+    p, q, r = x[s + 2], x[s + 3], x[s + 4]
+    e, f, g = y[s + 5], y[s + 6], y[s + 7]
+    m11 = p * p * e
+    m12 = p * (q * e + r * f)
+    m22 = q * q * e + 2.0 * q * r * f + r * r * g
+    large = 0.5 * (m11 + m22) + math.hypot(0.5 * (m11 - m22), m12)
+    log_large = math.log(large)
+    log_det = (y[s] + y[s + 1]) - (x[s] + x[s + 1])
+    return log_large, log_det - log_large
+
+
+@njit(cache=True, nogil=True, inline="always")
+def spd_log_eigenvalues3(x, y, s):
+    """Log generalized eigenvalues ``(large, middle, small)`` of the pair of 3 x 3 points
+    whose features start at ``s`` in ``x`` and ``y``: the largest of ``(B, A)``, the
+    smallest as the inverse of the largest of ``(A, B)``, the middle one from the
+    determinant."""
+    log_large = math.log(_pair_largest3(x, y, s))
+    log_small = -math.log(_pair_largest3(y, x, s))
+    log_det = (y[s] + y[s + 1] + y[s + 2]) - (x[s] + x[s + 1] + x[s + 2])
+    return log_large, log_det - log_large - log_small, log_small
+
+
+@njit(cache=True, nogil=True, inline="always")
+def spd_squared_distance(x, y, s, k):
+    """Squared affine-invariant distance of the SPD(k) points whose features start at ``s``."""
+    if k == 2:
+        u, v = spd_log_eigenvalues2(x, y, s)
+        return u * u + v * v
+    u, v, w = spd_log_eigenvalues3(x, y, s)
+    return u * u + v * v + w * w
