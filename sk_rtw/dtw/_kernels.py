@@ -43,6 +43,12 @@ SEGMENT_CODES = {
 _SPD_BLOCKS = {4: (SEGMENT_SPD2, 2), 9: (SEGMENT_SPD3, 3)}
 
 
+@njit(cache=True, nogil=True, inline="always")
+def spd_size(code):
+    """The matrix size ``k`` of an SPD segment's code."""
+    return code - SEGMENT_SPD2 + 2
+
+
 def _layout(manifold: Manifold) -> list[tuple[int, int, int, int, int]] | None:
     """Every segment as ``(start, stop, kernel start, kernel stop, code)``: where it lies
     in the flat point and in its kernel form; None if one has no kernel distance."""
@@ -83,7 +89,7 @@ def kernel_points(manifold: Manifold, flat: np.ndarray) -> np.ndarray:
     out = np.empty((points.shape[0], rows[-1][3]))
     for start, stop, a, b, code in rows:
         if code >= SEGMENT_SPD2:
-            k = 2 if code == SEGMENT_SPD2 else 3
+            k = spd_size(code)
             features = spd_features(np.ascontiguousarray(points[:, start:stop]), k)
             bad = ~np.isfinite(features).all(1)
             if bad.any():
@@ -319,7 +325,7 @@ def _robust_distance(xi, yj, segments):
             for k in range(start, stop):
                 scale, ssq = _accumulate_scaled(xi[k] - yj[k], scale, ssq)
         elif code >= SEGMENT_SPD2:  # log-eigenvalues are at most ~745: no overflow
-            spd = math.sqrt(spd_squared_distance(xi, yj, start, code - SEGMENT_SPD2 + 2))
+            spd = math.sqrt(spd_squared_distance(xi, yj, start, spd_size(code)))
             scale, ssq = _accumulate_scaled(spd, scale, ssq)
         else:
             dot = 0.0
@@ -366,7 +372,7 @@ def _cost_row(x, y, i, ny, segments, squared, row):
                 row[j] += sq
         elif code >= SEGMENT_SPD2:
             for j in range(ny):
-                row[j] += spd_squared_distance(xi, y[j], start, code - SEGMENT_SPD2 + 2)
+                row[j] += spd_squared_distance(xi, y[j], start, spd_size(code))
         else:
             for j in range(ny):
                 dot = 0.0

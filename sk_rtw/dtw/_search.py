@@ -146,7 +146,7 @@ def lb_keogh(y, lower, upper, segments, squared):
                 start, stop, code = segments[s, 0], segments[s, 1], segments[s, 2]
                 near = 0.0
                 if code >= _kernels.SEGMENT_SPD2:  # the sorted log-eigenvalues
-                    stop = start + code - _kernels.SEGMENT_SPD2 + 2
+                    stop = start + _kernels.spd_size(code)
                 for k in range(start, stop):
                     gap = _outside(y[j, k], lower[j, k], upper[j, k])
                     near += gap * gap

@@ -35,8 +35,6 @@ FEATURE_WIDTH = {2: 8, 3: 15}
 #: The same, indexed by ``k``, for the compiled code.
 FEATURE_WIDTH_ARRAY = np.array([0, 0, FEATURE_WIDTH[2], FEATURE_WIDTH[3]], dtype=np.int64)
 
-_TWO_THIRDS_PI = 2.0 * math.pi / 3.0
-
 
 @njit(cache=True, nogil=True, inline="always")
 def _eigenvalues2(a, b, c):
