@@ -19,7 +19,7 @@ import torch
 
 from .._backend import numpy_compatible, safe_norm, to_tensor
 from .._random import check_generator
-from ._mean import MEAN_MAX_ITER, MEAN_TOL, frechet_mean
+from ._mean import MEAN_MAX_ITER, MEAN_TOL, frechet_mean, group_expand
 
 #: Magnitudes beyond ``10 ** +-EXTREME_EXPONENT`` are aligned in a rescaled frame.
 EXTREME_EXPONENT = 100
@@ -141,6 +141,14 @@ class Manifold(ABC):
 
     @abstractmethod
     def _log(self, p: torch.Tensor, x: torch.Tensor) -> torch.Tensor: ...
+
+    def _group_log(
+        self, means: torch.Tensor, codes: torch.Tensor, points: torch.Tensor
+    ) -> torch.Tensor:
+        """``Log`` of every point at its group's mean: ``means`` (n_groups, ...), ``codes``
+        (N,), ``points`` (N, ...). Manifolds whose log first prepares the tangent point
+        (SPD's whitening) override it to prepare each mean once."""
+        return self._log(group_expand(means, codes), points)
 
     def _dist(self, p: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
         """Geodesic distance: the Riemannian norm of the log."""

@@ -85,7 +85,7 @@ def normalised_weights(
 
 def _step(manifold: Manifold, points, codes, weights, mean, n_groups):
     w = weights.reshape(*weights.shape, *([1] * manifold.point_ndim))
-    logs = manifold._log(group_expand(mean, codes), points)
+    logs = manifold._group_log(mean, codes, points)
     return manifold._exp(mean, group_sum(w * logs, codes, n_groups))
 
 

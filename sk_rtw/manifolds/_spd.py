@@ -8,9 +8,11 @@ import numpy as np
 import torch
 
 from .._backend import safe_norm
+from . import _spd2
 from ._base import EXTREME_EXPONENT, Manifold, power_of_two_scale
 from ._euclidean import _check_dim
-from ._symmetric import sym, symmetric_function
+from ._mean import group_expand
+from ._symmetric import distinct, eigenvalues, sym, symmetric_function, symmetric_functions
 
 #: Largest condition number of a non-diagonal SPD matrix accepted as a point (float64
 #: keeps the smallest eigenvalue to about ``MAX_CONDITION * 2.2e-16`` relative accuracy).
@@ -58,7 +60,7 @@ class SPD(Manifold):
 
     def _to_coordinates(self, p, v):
         # pyRiemann's ``upper``: the whitened matrix, diagonal and sqrt(2) x upper triangle
-        si = symmetric_function(p, "invsqrt")
+        si = symmetric_function(distinct(p), "invsqrt")
         w = sym(si @ v @ si)
         rows, cols, weight = self._triangle(w)
         return w[..., rows, cols] * weight
@@ -69,29 +71,47 @@ class SPD(Manifold):
         w = c.new_zeros(*lead, self.dim, self.dim)
         w[..., rows, cols] = (c / weight).expand(*lead, c.shape[-1])
         w = w + w.mT - torch.diag_embed(torch.diagonal(w, dim1=-2, dim2=-1))
-        s = symmetric_function(p, "sqrt")
+        s = symmetric_function(distinct(p), "sqrt")
         return sym(s @ w @ s)
 
     def _whiten(self, p):
-        return symmetric_function(p, "sqrt"), symmetric_function(p, "invsqrt")
+        """``p^½`` and ``p^-½`` from one eigendecomposition of each distinct ``p``."""
+        s, si = symmetric_functions(distinct(p), "sqrt", "invsqrt")
+        return s.expand_as(p), si.expand_as(p)
+
+    def _group_log(self, means, codes, points):
+        if self.dim == 2:  # each mean's chart once, not once per member
+            charts = _spd2.chart(means)
+            return _spd2.log(_spd2.group_chart(charts, lambda f: group_expand(f, codes)), points)
+        s, si = self._whiten(means)  # each mean once, not once per member
+        s, si = group_expand(s, codes), group_expand(si, codes)
+        return sym(s @ symmetric_function(si @ points @ si, "log") @ s)
 
     def _exp(self, p, v):
+        if self.dim == 2:
+            return _spd2.exp(p, v)
         s, si = self._whiten(p)
         return sym(s @ symmetric_function(si @ v @ si, "exp") @ s)
 
     def _log(self, p, x):
+        if self.dim == 2:
+            return _spd2.log(p, x)
         s, si = self._whiten(p)
         return sym(s @ symmetric_function(si @ x @ si, "log") @ s)
 
     def _dist(self, p, x):
-        si = symmetric_function(p, "invsqrt")
+        if self.dim == 2:
+            return _spd2.dist(p, x)
+        si = symmetric_function(distinct(p), "invsqrt")
         return _log_eigenvalue_norm(si @ x @ si)
 
     def _norm(self, p, v):
-        si = symmetric_function(p, "invsqrt")
+        si = symmetric_function(distinct(p), "invsqrt")
         return safe_norm(si @ v @ si, dim=(-2, -1))
 
     def _pairwise_dist(self, A, B):
+        if self.dim == 2:
+            return _spd2.dist(A.unsqueeze(-3), B.unsqueeze(-4))
         # Whiten each point of A once, not once per pair.
         si = symmetric_function(A, "invsqrt").unsqueeze(-3)
         inner = si @ B.unsqueeze(-4) @ si
@@ -177,4 +197,4 @@ def _log_eigenvalue_norm(S):
     """``||logm(S)||_F`` of SPD matrices from their eigenvalues alone (no eigenvectors, no
     reconstruction); its gradient, ``U diag(log(w) / w) U^T / ||.||``, has no
     ``1 / (w_i - w_j)`` terms and stays finite for repeated eigenvalues."""
-    return safe_norm(torch.log(torch.linalg.eigvalsh(sym(S))), dim=-1)
+    return safe_norm(torch.log(eigenvalues(S)), dim=-1)

@@ -6,6 +6,11 @@ infinite for repeated eigenvalues -- exactly the case ``p == x`` on the SPD mani
 formula instead: for ``F = U f(L) U^T`` the derivative is ``U (G * (U^T dS U)) U^T`` with
 the first divided differences ``G_ij = (f(l_i) - f(l_j)) / (l_i - l_j)`` and ``G_ii = f'(l_i)``,
 which stays finite when eigenvalues coincide.
+
+Several functions of the same matrices (``sqrt`` and ``invsqrt`` of a tangent point) share
+one decomposition. ``2 x 2`` matrices are decomposed in closed form by one Jacobi rotation
+(elementwise operations over the whole batch, on any device); ``torch.linalg.eigh`` runs a
+LAPACK call per matrix, whose overhead is most of the cost at this size.
 """
 
 from __future__ import annotations
@@ -50,31 +55,115 @@ def _divided_differences(name: str, w: torch.Tensor, fw: torch.Tensor) -> torch.
     return torch.where(close, _derivative(name, 0.5 * (wi + wj)), quotient)
 
 
-class _SymmetricFunction(torch.autograd.Function):
+def _eigh_2x2(S: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+    """Ascending eigenvalues and eigenvectors of symmetric 2 x 2 matrices, in closed form.
+
+    The Jacobi rotation ``t = sign(tau) / (|tau| + sqrt(1 + tau^2))``,
+    ``tau = (c - a) / (2 b)``, diagonalises ``[[a, b], [b, c]]`` to ``a - t b`` and
+    ``c + t b`` (Golub & Van Loan, section 8.5): each eigenvalue to a few units of rounding
+    of ``|S|``, a diagonal matrix exactly, of any conditioning.
+    """
+    a, b, c = S[..., 0, 0], S[..., 0, 1], S[..., 1, 1]
+    off = b != 0
+    safe_b = torch.where(off, b, torch.ones_like(b))
+    tau = (c - a) / (2.0 * safe_b)
+    one = torch.ones_like(tau)
+    t = torch.copysign(one, tau) / (tau.abs() + torch.hypot(one, tau))
+    t = torch.where(off, t, torch.zeros_like(t))
+    cos = torch.rsqrt(1.0 + t * t)
+    sin = t * cos
+    first, second = a - t * b, c + t * b
+    # columns (cos, -sin) for ``first`` and (sin, cos) for ``second``; ascending order
+    swap = first > second
+    w = torch.stack((torch.where(swap, second, first), torch.where(swap, first, second)), -1)
+    u0 = torch.stack((cos, -sin), -1)
+    u1 = torch.stack((sin, cos), -1)
+    lower = torch.where(swap.unsqueeze(-1), u1, u0)
+    upper = torch.where(swap.unsqueeze(-1), u0, u1)
+    return w, torch.stack((lower, upper), -1)
+
+
+def eigh(S: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+    """Ascending eigenvalues and orthonormal eigenvectors (columns) of symmetric ``S``; no
+    gradient (the callers' backward passes use them)."""
+    if S.shape[-1] == 2:
+        return _eigh_2x2(S)
+    return torch.linalg.eigh(S)
+
+
+class _SymmetricFunctions(torch.autograd.Function):
     @staticmethod
-    def forward(ctx, S: torch.Tensor, name: str) -> torch.Tensor:
-        w, U = torch.linalg.eigh(S)
-        fw = _apply(name, w)
-        ctx.save_for_backward(w, U, fw)
-        ctx.name = name
-        return (U * fw.unsqueeze(-2)) @ U.mT
+    def forward(ctx, S: torch.Tensor, names: tuple[str, ...]):
+        ctx.set_materialize_grads(False)
+        w, U = eigh(S)
+        values = [_apply(name, w) for name in names]
+        ctx.save_for_backward(w, U, *values)
+        ctx.names = names
+        return tuple((U * fw.unsqueeze(-2)) @ U.mT for fw in values)
+
+    @staticmethod
+    def backward(ctx, *grads: torch.Tensor):
+        w, U, *values = ctx.saved_tensors
+        total = None
+        for name, fw, grad in zip(ctx.names, values, grads, strict=True):
+            if grad is None:
+                continue
+            inner = U.mT @ sym(grad) @ U
+            term = _divided_differences(name, w, fw) * inner
+            total = term if total is None else total + term
+        if total is None:
+            return None, None
+        return U @ total @ U.mT, None
+
+
+class _Eigenvalues(torch.autograd.Function):
+    """Eigenvalues of symmetric ``2 x 2`` matrices; gradient ``U diag(g) U^T``."""
+
+    @staticmethod
+    def forward(ctx, S: torch.Tensor):
+        w, U = _eigh_2x2(S)
+        ctx.save_for_backward(U)
+        return w
 
     @staticmethod
     def backward(ctx, grad: torch.Tensor):
-        w, U, fw = ctx.saved_tensors
-        G = _divided_differences(ctx.name, w, fw)
-        sym = 0.5 * (grad + grad.mT)
-        inner = U.mT @ sym @ U
-        return U @ (G * inner) @ U.mT, None
+        (U,) = ctx.saved_tensors
+        return (U * grad.unsqueeze(-2)) @ U.mT
+
+
+def symmetric_functions(S: torch.Tensor, *names: str) -> tuple[torch.Tensor, ...]:
+    """Apply each of ``exp``, ``log``, ``sqrt``, ``invsqrt`` named in ``names`` to symmetric
+    matrices ``S`` (..., k, k), through one eigendecomposition."""
+    for name in names:
+        if name not in _NAMES:
+            raise ValueError(f"unknown matrix function {name!r}; expected one of {_NAMES}")
+    return _SymmetricFunctions.apply(sym(S), names)
 
 
 def symmetric_function(S: torch.Tensor, name: str) -> torch.Tensor:
     """Apply ``exp``, ``log``, ``sqrt`` or ``invsqrt`` to symmetric matrices ``S`` (..., k, k)."""
-    if name not in _NAMES:
-        raise ValueError(f"unknown matrix function {name!r}; expected one of {_NAMES}")
-    return _SymmetricFunction.apply(sym(S), name)
+    return symmetric_functions(S, name)[0]
+
+
+def eigenvalues(S: torch.Tensor) -> torch.Tensor:
+    """Ascending eigenvalues of symmetric matrices ``S`` (..., k, k), differentiable (the
+    gradient of a function of distinct or repeated eigenvalues stays finite)."""
+    S = sym(S)
+    if S.shape[-1] == 2:
+        return _Eigenvalues.apply(S)
+    return torch.linalg.eigvalsh(S)
 
 
 def sym(S: torch.Tensor) -> torch.Tensor:
     """Symmetric part of ``S``."""
     return 0.5 * (S + S.mT)
+
+
+def distinct(p: torch.Tensor) -> torch.Tensor:
+    """Matrices ``p`` (..., k, k) without their broadcast copies: leading dimensions of
+    stride 0 (``expand``) cut to length 1, so that what is computed from ``p`` is computed
+    once and broadcast back."""
+    for dim in range(p.ndim - 2):
+        if p.stride(dim) == 0 and p.shape[dim] > 1:
+            p = p.narrow(dim, 0, 1)
+    return p
