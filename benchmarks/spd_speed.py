@@ -6,12 +6,13 @@ Usage::
     python benchmarks/spd_speed.py --sections dtw --repeats 5
     python benchmarks/spd_speed.py --sections rlasa --shared-data ../shared/data
 
-Prints, on one thread, the best of ``--repeats`` wall times (after a warm-up call) and
+Prints, on one thread (torch's and numba's), the best of ``--repeats`` wall times (after a warm-up call) and
 their ratio to R^3 measured in the same run:
 
 ``dtw``
     ``dtw_pairwise_distance`` on 8 series of 200 samples (28 pairs, no band): R^3, SPD(2),
-    SPD(3) (closed-form kernel distances) and SPD(8) (eigenvalues of the whitened pair).
+    SPD(3) (closed-form kernel distances) and SPD(8) (compiled Householder-QL eigenvalues
+    of each whitened pair).
 ``align``
     ``sk_rtw.align`` with its defaults and ``dba_average`` on N = 30 series of T = 100
     samples: R^3 and SPD(2).
@@ -32,6 +33,7 @@ import sys
 import time
 from pathlib import Path
 
+import numba
 import numpy as np
 import torch
 
@@ -135,6 +137,7 @@ def main(argv=None) -> None:
                         "repository's ../shared/data)")  # fmt: skip
     args = parser.parse_args(argv)
     torch.set_num_threads(1)
+    numba.set_num_threads(1)  # the compiled DTW kernels too
     print(f"machine: {machine()}, one thread")
     if "dtw" in args.sections:
         dtw_rows(args.repeats)

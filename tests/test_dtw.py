@@ -206,12 +206,14 @@ def test_invalid_normalize_and_bad_series():
 
 def test_product_without_kernel_distance_uses_general_path():
     from sk_rtw.dtw._kernels import segment_codes
+    from sk_rtw.dtw._spd_kernels import MAX_KERNEL_SIZE
 
-    M = Product((Sphere(2), SPD(4)))  # SPD(4) has no closed-form kernel
+    k = MAX_KERNEL_SIZE + 1
+    M = Product((Sphere(2), SPD(k)))  # no kernel form beyond MAX_KERNEL_SIZE
     assert segment_codes(M) is None
     rng = np.random.default_rng(0)
     X = np.concatenate(
-        [Sphere(2).random_point((3, 6), rng), SPD(4).random_point((3, 6), rng).reshape(3, 6, 16)],
+        [Sphere(2).random_point((3, 6), rng), SPD(k).random_point((3, 6), rng).reshape(3, 6, -1)],
         axis=-1,
     )
     D = dtw_pairwise_distance(X, manifold=M)

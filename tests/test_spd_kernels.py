@@ -41,9 +41,14 @@ def _reference(A, B):
     return float(mp.sqrt(sum(mp.log(v) ** 2 for v in eigenvalues)))
 
 
-@pytest.mark.parametrize("k", [2, 3])
+@pytest.mark.parametrize("k", [2, 3, 4, 8])
 @pytest.mark.parametrize(("spread", "rtol"), [("moderate", 1e-12), ("wide", 1e-8)])
 def test_kernel_distances_match_50_digit_arithmetic(k, spread, rtol):
+    """Closed forms (2, 3) and the compiled Householder-QL route (4 .. 12); eigenvalues
+    over 1e-4 .. 1e4 make whitened pairs conditioned up to 1e16, where the QL route keeps
+    1e-6 (the issue's bound 1e-5; LAPACK's eigh route gave 1.3e-6)."""
+    if k > 3 and spread == "wide":
+        rtol = 1e-6
     rng = np.random.default_rng(k)
     A, B = _points(k, 25, rng, spread), _points(k, 25, rng, spread)
     M = SPD(k)
@@ -54,7 +59,7 @@ def test_kernel_distances_match_50_digit_arithmetic(k, spread, rtol):
     np.testing.assert_allclose(mine, expected, rtol=rtol)
 
 
-@pytest.mark.parametrize("k", [2, 3])
+@pytest.mark.parametrize("k", [2, 3, 4, 8])
 def test_kernel_distances_of_nearby_points_are_accurate_in_absolute_terms(k):
     """Points 1e-7 apart: the distance to about 1e-15 absolute (no cancellation)."""
     rng = np.random.default_rng(5)
@@ -70,7 +75,7 @@ def test_kernel_distances_of_nearby_points_are_accurate_in_absolute_terms(k):
     assert _kernel_distances(*(kernel_points(M, A.reshape(15, -1)),) * 2, k).max() < 1e-7
 
 
-@pytest.mark.parametrize("k", [2, 3])
+@pytest.mark.parametrize("k", [2, 3, 4, 8])
 def test_dtw_on_spd_equals_the_recursion_over_the_torch_cost_matrix(k):
     rng = np.random.default_rng(11)
     M = SPD(k)
@@ -99,7 +104,7 @@ def test_a_product_with_an_spd_factor_gets_kernel_distances():
     assert D[0, 1] == pytest.approx(final_cost(cost, 20, 20, -1.0), rel=1e-10)
 
 
-@pytest.mark.parametrize("k", [2, 3])
+@pytest.mark.parametrize("k", [2, 3, 4, 8])
 def test_sorted_log_eigenvalues_bound_the_distance_from_below(k):
     """The lower bound the nearest search prunes with: ||log lambda(A) - log lambda(B)||
     <= dist(A, B), with near equality for commuting matrices."""
@@ -136,8 +141,50 @@ def test_nearest_search_on_spd_equals_the_exhaustive_search(window):
     np.testing.assert_array_equal(found, expected)
 
 
-def test_a_point_without_a_cholesky_factor_is_refused_clearly():
-    M = SPD(3)
-    point = np.diag([1.0, 1.0, 0.0]).reshape(1, 9)
+@pytest.mark.parametrize("k", [3, 8])
+def test_a_point_without_a_cholesky_factor_is_refused_clearly(k):
+    M = SPD(k)
+    point = np.diag([1.0] * (k - 1) + [0.0]).reshape(1, k * k)
     with pytest.raises(ValueError, match="has no Cholesky factor"):
         kernel_points(M, point)
+
+
+def test_kernel_sizes_end_at_max_kernel_size():
+    """Up to MAX_KERNEL_SIZE an SPD block has a kernel form (code 3 + k - 2); beyond it
+    the manifold's own pairwise distance is used, with the same DTW."""
+    from sk_rtw.dtw._spd_kernels import MAX_KERNEL_SIZE
+
+    largest, beyond = SPD(MAX_KERNEL_SIZE), SPD(MAX_KERNEL_SIZE + 1)
+    assert segment_codes(largest).tolist() == [[0, MAX_KERNEL_SIZE * (MAX_KERNEL_SIZE + 2),
+                                                MAX_KERNEL_SIZE + 1]]  # fmt: skip
+    assert segment_codes(beyond) is None
+    rng = np.random.default_rng(4)
+    for M in (largest, beyond):
+        X = M.random_point((2, 6), random_state=rng)
+        cost = np.asarray(M.pairwise_dist(X[0], X[1]))
+        D = dtw_pairwise_distance(X, manifold=M)
+        assert D[0, 1] == pytest.approx(final_cost(cost, 6, 6, -1.0), rel=1e-10)
+
+
+@pytest.mark.parametrize("spectrum", [(1.0, 1.0 + 1e-9, 5.0), (0.2, 1.0, 1.0 + 1e-12),
+                                      (0.3, 0.3, 0.3), (1e-3, 1e-3 * (1 + 1e-8), 1.0),
+                                      (1e-4, 0.5, 1e4)])  # fmt: skip
+def test_spd3_pairs_with_meeting_or_spread_eigenvalues_match_50_digit_arithmetic(spectrum):
+    """The SPD(3) kernel takes the largest and smallest generalized eigenvalues from one
+    trigonometric solution; where two meet its angle is off by ~sqrt(eps), which must not
+    reach the distance (the pair's product is exact), and a spread pair takes the
+    smallest from the reverse pair."""
+    rng = np.random.default_rng(8)
+    A = _points(3, 6, rng, "moderate")
+    q, _ = np.linalg.qr(rng.standard_normal((6, 3, 3)))
+    values, vectors = np.linalg.eigh(A)
+    root = (vectors * np.sqrt(values)[:, None, :]) @ np.swapaxes(vectors, 1, 2)
+    B = root @ (q * np.array(spectrum)[None, None, :]) @ np.swapaxes(q, 1, 2) @ root
+    B = 0.5 * (B + np.swapaxes(B, 1, 2))
+    M = SPD(3)
+    mine = _kernel_distances(
+        kernel_points(M, A.reshape(6, -1)), kernel_points(M, B.reshape(6, -1)), 3
+    )
+    expected = np.array([_reference(a, b) for a, b in zip(A, B, strict=True)])
+    rtol = 1e-8 if spectrum[-1] / spectrum[0] > 1e6 else 1e-10  # as the "wide" test above
+    np.testing.assert_allclose(mine, expected, rtol=rtol, atol=1e-13)

@@ -24,7 +24,7 @@ import numpy as np
 from numba import njit, prange
 
 from ..manifolds import Manifold
-from ._spd_kernels import FEATURE_WIDTH, spd_features, spd_squared_distance
+from ._spd_kernels import MAX_KERNEL_SIZE, feature_width, spd_features, spd_squared_distance
 
 _INF = np.inf
 
@@ -32,15 +32,15 @@ _INF = np.inf
 SEGMENT_EUCLIDEAN = 0
 SEGMENT_SPHERE = 1
 SEGMENT_SIGN_INVARIANT_SPHERE = 2
+#: SPD(k) blocks, 2 <= k <= MAX_KERNEL_SIZE, have the code ``SEGMENT_SPD2 + k - 2``.
 SEGMENT_SPD2 = 3
-SEGMENT_SPD3 = 4
 SEGMENT_CODES = {
     "euclidean": SEGMENT_EUCLIDEAN,
     "sphere": SEGMENT_SPHERE,
     "sign-invariant sphere": SEGMENT_SIGN_INVARIANT_SPHERE,
 }
 #: SPD(k) blocks with a kernel form: their size ``k * k``, their code and ``k``.
-_SPD_BLOCKS = {4: (SEGMENT_SPD2, 2), 9: (SEGMENT_SPD3, 3)}
+_SPD_BLOCKS = {k * k: (SEGMENT_SPD2 + k - 2, k) for k in range(2, MAX_KERNEL_SIZE + 1)}
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -59,7 +59,7 @@ def _layout(manifold: Manifold) -> list[tuple[int, int, int, int, int]] | None:
     for start, stop, kind in segments:
         if kind == "spd" and stop - start in _SPD_BLOCKS:
             code, k = _SPD_BLOCKS[stop - start]
-            width = FEATURE_WIDTH[k]
+            width = feature_width(k)
         elif kind in SEGMENT_CODES:
             code, width = SEGMENT_CODES[kind], stop - start
         else:

@@ -1,4 +1,5 @@
-"""Affine-invariant SPD distances for the DTW kernels, in closed form for 2 x 2 and 3 x 3.
+"""Affine-invariant SPD distances for the DTW kernels: closed forms for 2 x 2 and 3 x 3,
+compiled Householder and QL up to ``MAX_KERNEL_SIZE``.
 
 ``dist(A, B)^2 = sum_i log(lambda_i)^2`` over the eigenvalues of ``M = L^-1 B L^-T``
 (``A = L L^T``, Cholesky), the generalized eigenvalues of ``(B, A)``: no matrix function
@@ -11,7 +12,9 @@ Smith 1961) -- no eigendecomposition, no LAPACK call per pair.
 Only largest eigenvalues are taken from a formula (a sum of positive terms: no
 cancellation); the smaller of two comes from the determinant (``det M = det B / det A``,
 known from the log-eigenvalues), the smallest of three as the inverse of the largest of
-the reverse pair ``(A, B)`` and the middle one from the determinant.
+the reverse pair ``(A, B)`` and the middle one from the determinant. Larger pairs (``k``
+from 4 to ``MAX_KERNEL_SIZE``) take the eigenvalues of the same congruence from a
+Householder reduction and the implicit QL iteration, compiled, one pair at a time.
 
 The sorted log-eigenvalues are also a lower bound: ``||log lambda(A) - log lambda(B)||``
 is at most ``dist(A, B)`` (the sorted log-spectrum is 1-Lipschitz for the
@@ -30,10 +33,18 @@ import math
 import numpy as np
 from numba import njit
 
-#: Number of features of an SPD(k) point, for the sizes with a closed form.
-FEATURE_WIDTH = {2: 8, 3: 15}
-#: The same, indexed by ``k``, for the compiled code.
-FEATURE_WIDTH_ARRAY = np.array([0, 0, FEATURE_WIDTH[2], FEATURE_WIDTH[3]], dtype=np.int64)
+#: Largest matrix size with a kernel form. Up to it, a pair's eigenvalues by Householder
+#: tridiagonalisation and implicit QL in compiled code beat a batched LAPACK call per
+#: pair (whose overhead dominates at this size); beyond it LAPACK's blocked code wins.
+MAX_KERNEL_SIZE = 12
+
+
+_TWO_THIRDS_PI = 2.0 * math.pi / 3.0
+
+
+def feature_width(k: int) -> int:
+    """Number of features of an SPD(k) point: ``k`` log-eigenvalues and two triangles."""
+    return k * (k + 2)
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -47,15 +58,15 @@ def _eigenvalues2(a, b, c):
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _largest3(m11, m12, m13, m22, m23, m33):
-    """Largest eigenvalue of a symmetric positive definite 3 x 3 matrix by the
-    trigonometric solution of its characteristic cubic (Smith 1961): ``q + 2 p cos(phi)``
-    with ``cos(phi) >= 1/2``, a sum of positive terms."""
+def _trigonometric3(m11, m12, m13, m22, m23, m33):
+    """``(q, p, phi)`` of the trigonometric solution of the characteristic cubic of a
+    symmetric 3 x 3 matrix (Smith 1961): its eigenvalues are ``q + 2 p cos(phi + 2 pi
+    j / 3)``, ``j = 0, 1, 2``, the largest at ``j = 0`` (``cos(phi) >= 1/2``)."""
     q = (m11 + m22 + m33) / 3.0
     d11, d22, d33 = m11 - q, m22 - q, m33 - q
     p2 = d11 * d11 + d22 * d22 + d33 * d33 + 2.0 * (m12 * m12 + m13 * m13 + m23 * m23)
     if p2 == 0.0:  # a multiple of the identity
-        return q
+        return q, 0.0, 0.0
     p = math.sqrt(p2 / 6.0)
     det = (
         d11 * (d22 * d33 - m23 * m23)
@@ -63,7 +74,15 @@ def _largest3(m11, m12, m13, m22, m23, m33):
         + m13 * (m12 * m23 - d22 * m13)
     )
     r = min(1.0, max(-1.0, 0.5 * det / (p * p * p)))  # det((M - q I) / p) / 2
-    return q + 2.0 * p * math.cos(math.acos(r) / 3.0)
+    return q, p, math.acos(r) / 3.0
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _largest3(m11, m12, m13, m22, m23, m33):
+    """Largest eigenvalue of a symmetric positive definite 3 x 3 matrix: ``q + 2 p
+    cos(phi)`` of :func:`_trigonometric3`, a sum of positive terms."""
+    q, p, phi = _trigonometric3(m11, m12, m13, m22, m23, m33)
+    return q + 2.0 * p * math.cos(phi)
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -100,10 +119,13 @@ def _pair_largest3(x, y, s):
 
 @njit(cache=True, nogil=True, error_model="numpy")
 def spd_features(points, k):
-    """The features (module docstring) of flat SPD(k) points ``(n, k * k)``, ``k`` 2 or 3;
-    not finite for a point that is not positive definite in float64."""
+    """The features (module docstring) of flat SPD(k) points ``(n, k * k)``, ``2 <= k <=
+    MAX_KERNEL_SIZE``; not finite for a point that is not positive definite in float64."""
     n = points.shape[0]
-    out = np.empty((n, FEATURE_WIDTH_ARRAY[k]))
+    out = np.empty((n, k * (k + 2)))
+    if k > 3:
+        _general_features(points, k, out)
+        return out
     for t in range(n):
         x = points[t]
         f = out[t]
@@ -157,7 +179,8 @@ def spd_log_eigenvalues2(x, y, s):
     m11 = p * p * e
     m12 = p * (q * e + r * f)
     m22 = q * q * e + 2.0 * q * r * f + r * r * g
-    large = 0.5 * (m11 + m22) + math.hypot(0.5 * (m11 - m22), m12)
+    half_gap = 0.5 * (m11 - m22)
+    large = 0.5 * (m11 + m22) + math.sqrt(half_gap * half_gap + m12 * m12)
     log_large = math.log(large)
     log_det = (y[s] + y[s + 1]) - (x[s] + x[s + 1])
     return log_large, log_det - log_large
@@ -166,11 +189,28 @@ def spd_log_eigenvalues2(x, y, s):
 @njit(cache=True, nogil=True, inline="always")
 def spd_log_eigenvalues3(x, y, s):
     """Log generalized eigenvalues ``(large, middle, small)`` of the pair of 3 x 3 points
-    whose features start at ``s`` in ``x`` and ``y``: the largest of ``(B, A)``, the
-    smallest as the inverse of the largest of ``(A, B)``, the middle one from the
-    determinant."""
-    log_large = math.log(_pair_largest3(x, y, s))
-    log_small = -math.log(_pair_largest3(y, x, s))
+    whose features start at ``s`` in ``x`` and ``y``: the largest and the smallest of
+    ``(B, A)`` from one trigonometric solution, the middle one from the determinant.
+
+    The smallest, ``q + 2 p cos(phi + 2 pi / 3)``, is a difference: it keeps its relative
+    accuracy (to ``eps * large / small``) while it is above ``large / 100``; below, it is
+    taken as the inverse of the largest of the reverse pair ``(A, B)`` instead (a sum).
+    Where the two smaller eigenvalues nearly meet, ``phi`` carries an error of order
+    ``sqrt(eps)`` that moves them in opposite directions with their product fixed: the
+    squared distance changes only to second order.
+    """
+    m11, m12, m13, m22, m23, m33 = _congruence3(
+        x[s + 3], x[s + 4], x[s + 5], x[s + 6], x[s + 7], x[s + 8],
+        y[s + 9], y[s + 10], y[s + 11], y[s + 12], y[s + 13], y[s + 14],
+    )  # fmt: skip
+    q, p, phi = _trigonometric3(m11, m12, m13, m22, m23, m33)
+    large = q + 2.0 * p * math.cos(phi)
+    small = q + 2.0 * p * math.cos(phi + _TWO_THIRDS_PI)
+    log_large = math.log(large)
+    if small > 0.01 * large:
+        log_small = math.log(small)
+    else:
+        log_small = -math.log(_pair_largest3(y, x, s))
     log_det = (y[s] + y[s + 1] + y[s + 2]) - (x[s] + x[s + 1] + x[s + 2])
     return log_large, log_det - log_large - log_small, log_small
 
@@ -181,5 +221,186 @@ def spd_squared_distance(x, y, s, k):
     if k == 2:
         u, v = spd_log_eigenvalues2(x, y, s)
         return u * u + v * v
-    u, v, w = spd_log_eigenvalues3(x, y, s)
-    return u * u + v * v + w * w
+    if k == 3:
+        u, v, w = spd_log_eigenvalues3(x, y, s)
+        return u * u + v * v + w * w
+    return _general_squared_distance(x, y, s, k)
+
+
+# ---------------------------------------------------------------- k = 4 .. MAX_KERNEL_SIZE
+@njit(cache=True, nogil=True, error_model="numpy")
+def _general_features(points, k, out):
+    """:func:`spd_features` for ``k > 3``: the Cholesky factor's inverse by forward
+    substitution, the log-eigenvalues by :func:`_symmetric_eigenvalues`."""
+    work = np.empty((k, k))
+    diagonal, off = np.empty(k), np.empty(k)
+    inverse_start, point_start = k, k + k * (k + 1) // 2
+    for t in range(points.shape[0]):
+        f = out[t]
+        A = np.empty((k, k))
+        for i in range(k):
+            for j in range(k):
+                A[i, j] = 0.5 * (points[t, i * k + j] + points[t, j * k + i])
+        L = np.zeros((k, k))  # Cholesky, lower; NaN when not positive definite
+        for j in range(k):
+            total = A[j, j]
+            for m in range(j):
+                total -= L[j, m] * L[j, m]
+            L[j, j] = math.sqrt(total) if total > 0.0 else np.nan
+            for i in range(j + 1, k):
+                total = A[i, j]
+                for m in range(j):
+                    total -= L[i, m] * L[j, m]
+                L[i, j] = total / L[j, j]
+        index = inverse_start
+        for i in range(k):  # row i of L^-1 (lower triangle)
+            for j in range(i + 1):
+                if i == j:
+                    value = 1.0 / L[i, i]
+                else:
+                    total = 0.0
+                    for m in range(j, i):
+                        total += L[i, m] * f[inverse_start + m * (m + 1) // 2 + j]
+                    value = -total / L[i, i]
+                f[index] = value
+                index += 1
+        for i in range(k):
+            for j in range(i + 1):
+                work[i, j] = A[i, j]
+        _symmetric_eigenvalues(work, k, diagonal, off)
+        diagonal.sort()
+        for i in range(k):
+            f[i] = math.log(diagonal[i]) if diagonal[i] > 0.0 else np.nan
+        index = point_start
+        for i in range(k):
+            for j in range(i, k):
+                f[index] = A[i, j]
+                index += 1
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _general_squared_distance(x, y, s, k):
+    """``sum log(lambda)^2`` over the eigenvalues of ``L^-1 B L^-T`` (lower triangle
+    formed, then :func:`_symmetric_eigenvalues`)."""
+    inverse = s + k
+    point = inverse + k * (k + 1) // 2
+    work = np.empty(3 * k * k + 2 * k)  # one allocation per pair
+    B = work[: k * k].reshape(k, k)
+    N = work[k * k : 2 * k * k].reshape(k, k)  # L^-1 B, row by row
+    M = work[2 * k * k : 3 * k * k].reshape(k, k)  # the lower triangle of N L^-T
+    diagonal, off = work[3 * k * k : 3 * k * k + k], work[3 * k * k + k :]
+    index = point
+    for i in range(k):
+        for j in range(i, k):
+            B[i, j] = y[index]
+            B[j, i] = y[index]
+            index += 1
+    for i in range(k):
+        row = inverse + i * (i + 1) // 2
+        for j in range(k):
+            total = 0.0
+            for m in range(i + 1):
+                total += x[row + m] * B[m, j]
+            N[i, j] = total
+    for i in range(k):
+        for j in range(i + 1):
+            row = inverse + j * (j + 1) // 2
+            total = 0.0
+            for m in range(j + 1):
+                total += N[i, m] * x[row + m]
+            M[i, j] = total
+    _symmetric_eigenvalues(M, k, diagonal, off)
+    total = 0.0
+    for i in range(k):
+        value = math.log(diagonal[i])
+        total += value * value
+    return total
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _symmetric_eigenvalues(a, n, d, e):
+    """The eigenvalues, into ``d`` (unordered), of the symmetric matrix whose lower triangle is
+    ``a`` (overwritten; ``e`` is scratch): Householder reduction to tridiagonal form and
+    the implicit QL iteration with Wilkinson shifts (eigenvalues only: Press et al.,
+    *Numerical Recipes*, 3rd ed., sections 11.3-11.4, ``tred2`` and ``tqli``)."""
+    for i in range(n - 1, 0, -1):
+        last = i - 1
+        h = 0.0
+        if last > 0:
+            scale = 0.0
+            for m in range(last + 1):
+                scale += abs(a[i, m])
+            if scale == 0.0:
+                e[i] = a[i, last]
+            else:
+                for m in range(last + 1):
+                    a[i, m] /= scale
+                    h += a[i, m] * a[i, m]
+                f = a[i, last]
+                g = -math.sqrt(h) if f >= 0.0 else math.sqrt(h)
+                e[i] = scale * g
+                h -= f * g
+                a[i, last] = f - g
+                f = 0.0
+                for j in range(last + 1):
+                    g = 0.0
+                    for m in range(j + 1):
+                        g += a[j, m] * a[i, m]
+                    for m in range(j + 1, last + 1):
+                        g += a[m, j] * a[i, m]
+                    e[j] = g / h
+                    f += e[j] * a[i, j]
+                hh = f / (h + h)
+                for j in range(last + 1):
+                    f = a[i, j]
+                    g = e[j] - hh * f
+                    e[j] = g
+                    for m in range(j + 1):
+                        a[j, m] -= f * e[m] + g * a[i, m]
+        else:
+            e[i] = a[i, last]
+        d[i] = h
+    for i in range(n):
+        d[i] = a[i, i]
+    for i in range(1, n):
+        e[i - 1] = e[i]
+    e[n - 1] = 0.0
+    for start in range(n):
+        for _ in range(64):
+            m = start
+            while m < n - 1:
+                dd = abs(d[m]) + abs(d[m + 1])
+                if abs(e[m]) <= 2.220446049250313e-16 * dd:
+                    break
+                m += 1
+            if m == start:
+                break
+            g = (d[start + 1] - d[start]) / (2.0 * e[start])
+            r = math.sqrt(g * g + 1.0)
+            g = d[m] - d[start] + e[start] / (g + (r if g >= 0.0 else -r))
+            s, c, p = 1.0, 1.0, 0.0
+            i = m - 1
+            deflated = False
+            while i >= start:
+                f = s * e[i]
+                b = c * e[i]
+                r = math.sqrt(f * f + g * g)
+                e[i + 1] = r
+                if r == 0.0:
+                    d[i + 1] -= p
+                    e[m] = 0.0
+                    deflated = True
+                    break
+                s = f / r
+                c = g / r
+                g = d[i + 1] - p
+                r = (d[i] - g) * s + 2.0 * c * b
+                p = s * r
+                d[i + 1] = g + p
+                g = c * r - b
+                i -= 1
+            if deflated:
+                continue
+            d[start] -= p
+            e[start] = g
+            e[m] = 0.0
