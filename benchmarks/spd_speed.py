@@ -5,9 +5,10 @@ Usage::
     python benchmarks/spd_speed.py                       # about 2 minutes on one thread
     python benchmarks/spd_speed.py --sections dtw --repeats 5
     python benchmarks/spd_speed.py --sections rlasa --shared-data ../shared/data
+    python benchmarks/spd_speed.py --sections eigh
 
-Prints, on one thread (torch's and numba's), the best of ``--repeats`` wall times (after a warm-up call) and
-their ratio to R^3 measured in the same run:
+Prints, on one thread (torch's and numba's), the best of ``--repeats`` wall times (after
+a warm-up call) and their ratio to R^3 measured in the same run:
 
 ``dtw``
     ``dtw_pairwise_distance`` on 8 series of 200 samples (28 pairs, no band): R^3, SPD(2),
@@ -16,6 +17,10 @@ their ratio to R^3 measured in the same run:
 ``align``
     ``sk_rtw.align`` with its defaults and ``dba_average`` on N = 30 series of T = 100
     samples: R^3 and SPD(2).
+``eigh``
+    How many LAPACK eigendecompositions (``torch.linalg.eigh`` and ``eigvalsh`` calls and
+    the matrices in them) one ``align`` (20 epochs) makes on N = 10 series of T = 100
+    samples of SPD(8) and SPD(2), and its wall time (not part of the default run).
 ``rlasa``
     ``RTWNearestCentroid()`` (defaults) on R-LASA's 30 shapes (``--shared-data``), the
     first 3 demonstrations of each for training and the 4th for prediction, every 5th
@@ -37,14 +42,16 @@ import numba
 import numpy as np
 import torch
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the repository; then _shared
+# the repository (for benchmarks._shared), after PYTHONPATH: an earlier checkout named
+# there is the one measured
+sys.path.append(str(Path(__file__).resolve().parents[1]))
 
 from benchmarks._shared import machine, positive_int
 from sk_rtw import RTWNearestCentroid, align, dtw_pairwise_distance
 from sk_rtw.baselines import dba_average
 from sk_rtw.manifolds import SPD, Euclidean
 
-SECTIONS = ("dtw", "align", "rlasa")
+SECTIONS = ("dtw", "align", "rlasa", "eigh")
 
 
 def best_time(call, repeats: int) -> float:
@@ -124,28 +131,66 @@ def rlasa_rows(shared_data: str) -> None:
     print(f"  spd / quaternion: fit {fit_s / fit_q:.1f}x, prediction {predict_s / predict_q:.1f}x")
 
 
+def eigh_rows(n_series: int = 10, length: int = 100, n_epochs: int = 20) -> None:
+    print(f"\nalign ({n_epochs} epochs) on N = {n_series} series of T = {length} samples: "
+          "LAPACK eigendecompositions")  # fmt: skip
+    counts: dict[str, list[int]] = {}
+    originals = {name: getattr(torch.linalg, name) for name in ("eigh", "eigvalsh")}
+
+    def counting(name):
+        def call(S, *args, **kwargs):
+            entry = counts.setdefault(name, [0, 0])
+            entry[0] += 1
+            entry[1] += S[..., 0, 0].numel()
+            return originals[name](S, *args, **kwargs)
+
+        return call
+
+    try:
+        for name in originals:
+            setattr(torch.linalg, name, counting(name))
+        for manifold in (SPD(8), SPD(2)):
+            counts.clear()
+            X = smooth_series(manifold, n_series, length)
+            start = time.perf_counter()
+            align(X, manifold=manifold, random_state=0, n_epochs=n_epochs)
+            seconds = time.perf_counter() - start
+            found = ", ".join(f"{name} {calls} calls on {matrices / 1e6:.2f} million matrices"
+                              for name, (calls, matrices) in counts.items()) or "none"  # fmt: skip
+            print(f"  {manifold!r:>14}: {seconds:6.1f} s; {found}", flush=True)
+    finally:
+        for name, original in originals.items():
+            setattr(torch.linalg, name, original)
+
+
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(
         description=__doc__.splitlines()[0],
         epilog=__doc__.split("Usage::")[1].split("Prints")[0],
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    parser.add_argument("--sections", nargs="+", choices=SECTIONS, default=list(SECTIONS))
+    parser.add_argument("--sections", nargs="+", choices=SECTIONS, default=list(SECTIONS[:3]))
     parser.add_argument("--repeats", type=positive_int, default=3)
     parser.add_argument("--shared-data", default=None,
                         help="folder holding r_lasa/ (the rlasa section; default: the "
                         "repository's ../shared/data)")  # fmt: skip
     args = parser.parse_args(argv)
+    threads = torch.get_num_threads(), numba.get_num_threads()
     torch.set_num_threads(1)
     numba.set_num_threads(1)  # the compiled DTW kernels too
-    print(f"machine: {machine()}, one thread")
-    if "dtw" in args.sections:
-        dtw_rows(args.repeats)
-    if "align" in args.sections:
-        align_rows(args.repeats)
-    if "rlasa" in args.sections:
-        rlasa_rows(args.shared_data)
-
+    try:
+        print(f"machine: {machine()}, one thread")
+        if "dtw" in args.sections:
+            dtw_rows(args.repeats)
+        if "align" in args.sections:
+            align_rows(args.repeats)
+        if "rlasa" in args.sections:
+            rlasa_rows(args.shared_data)
+        if "eigh" in args.sections:
+            eigh_rows()
+    finally:
+        torch.set_num_threads(threads[0])
+        numba.set_num_threads(threads[1])
 
 if __name__ == "__main__":
     main()

@@ -223,11 +223,31 @@ def test_the_scale_benchmark_fixes_the_band_of_its_rows_when_asked(monkeypatch, 
 
 def test_the_spd_speed_benchmark_prints_each_manifold_against_r3(capsys):
     """benchmarks/spd_speed.py's DTW section: one row per manifold, R^3 the 1.0x row."""
+    import numba
+    import torch
+
     from benchmarks import spd_speed
 
+    threads = torch.get_num_threads(), numba.get_num_threads()
     spd_speed.main(["--sections", "dtw", "--repeats", "1"])
+    assert (torch.get_num_threads(), numba.get_num_threads()) == threads  # put back
     rows = [line for line in capsys.readouterr().out.splitlines() if "x R^3" in line]
     assert [row.split(":")[0].strip() for row in rows] == [
         "Euclidean(dim=3)", "SPD(dim=2)", "SPD(dim=3)", "SPD(dim=8)"
     ]
     assert rows[0].endswith("1.0x R^3")
+
+
+def test_the_spd_speed_benchmark_counts_eigendecompositions(capsys):
+    """The eigh section counts LAPACK calls by SPD size and puts torch back as it was."""
+    import torch
+
+    from benchmarks import spd_speed
+
+    eigh, threads = torch.linalg.eigh, torch.get_num_threads()
+    spd_speed.eigh_rows(n_series=3, length=12, n_epochs=1)
+    rows = [line for line in capsys.readouterr().out.splitlines() if "SPD(dim=" in line]
+    assert [row.split(":")[0].strip() for row in rows] == ["SPD(dim=8)", "SPD(dim=2)"]
+    assert "eigh " in rows[0] and "million matrices" in rows[0]
+    assert "eigh " not in rows[1]  # SPD(2) has closed forms: no eigendecomposition
+    assert torch.linalg.eigh is eigh and torch.get_num_threads() == threads

@@ -24,6 +24,10 @@ Hoffman-Wielandt inequality), so LB_Keogh over those coordinates bounds DTW from
 A flat SPD(k) point is ``k * k`` row-major entries; its features are, in order, the ``k``
 ascending log-eigenvalues, the ``k (k + 1) / 2`` entries of ``L^-1`` row by row (lower
 triangle) and the ``k (k + 1) / 2`` entries of the point row by row (upper triangle).
+
+The functions here are inlined into :mod:`sk_rtw.dtw._kernels`, whose numba cache does
+not follow a change in this module: after editing it, delete the ``*.nbi`` / ``*.nbc``
+files under ``sk_rtw/dtw/__pycache__`` (a clean checkout or an installed release has none).
 """
 
 from __future__ import annotations

@@ -24,9 +24,11 @@ class SPD(Manifold):
     """SPD(k): symmetric positive definite ``k x k`` matrices, affine-invariant metric.
 
     ``Exp_P(V) = P^½ expm(P^-½ V P^-½) P^½``, ``Log_P(X) = P^½ logm(P^-½ X P^-½) P^½`` and
-    ``dist(P, X) = ||logm(P^-½ X P^-½)||_F``. Every matrix function goes through one
-    symmetric eigendecomposition, with a gradient that stays finite for repeated
-    eigenvalues (``P = X``).
+    ``dist(P, X) = ||logm(P^-½ X P^-½)||_F``. For ``k = 2`` all three are closed forms in
+    the two eigenvalues of ``P^-1 X`` (no eigendecomposition); for larger ``k`` every
+    matrix function goes through one symmetric eigendecomposition (shared by ``P^½`` and
+    ``P^-½``, once per distinct tangent point) and distances through eigenvalues only.
+    Gradients stay finite for repeated eigenvalues (``P = X``).
 
     Parameters
     ----------

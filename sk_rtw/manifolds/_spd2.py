@@ -160,25 +160,25 @@ def _log_det_ratio(p: Chart, x) -> torch.Tensor:
 def log(p: torch.Tensor | Chart, x: torch.Tensor) -> torch.Tensor:
     """``Log_P(X)`` for SPD(2) points ``p`` (or their :class:`Chart`) and ``x`` (broadcast,
     ``(..., 2, 2)``)."""
-    p = p if isinstance(p, Chart) else chart(p)
-    m, r2, x = _congruence(p, x)
-    mean_value, slope = _log_coefficients(m, r2, _log_det_ratio(p, x))
-    return _combine(mean_value, slope, m, p, x)
+    base = p if isinstance(p, Chart) else chart(p)
+    m, r2, entries = _congruence(base, x)
+    mean_value, slope = _log_coefficients(m, r2, _log_det_ratio(base, entries))
+    return _combine(mean_value, slope, m, base, entries)
 
 
 def exp(p: torch.Tensor, v: torch.Tensor) -> torch.Tensor:
     """``Exp_P(V)`` for an SPD(2) point ``p`` and a symmetric tangent vector ``v``."""
-    p = chart(p)
-    m, r2, v = _congruence(p, v)
+    base = chart(p)
+    m, r2, entries = _congruence(base, v)
     mean_value, slope = _exp_coefficients(m, r2)
-    return _combine(mean_value, slope, m, p, v)
+    return _combine(mean_value, slope, m, base, entries)
 
 
 def squared_dist(p: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
     """``dist(P, X)^2 = log(det M)^2 / 2 + 2 atanh(r / m)^2`` (``M = P^-1 X``)."""
-    p = chart(p)
-    m, r2, entries = _congruence(p, x)
-    log_det = _log_det_ratio(p, entries)
+    base = chart(p)
+    m, r2, entries = _congruence(base, x)
+    log_det = _log_det_ratio(base, entries)
     x2 = r2 / (m * m)
     small = x2 < _SERIES_BELOW
     atanh = _atanh_ratio(m, r2, x2, small, log_det)
