@@ -2,7 +2,7 @@
 
 Usage::
 
-    python benchmarks/spd_speed.py                       # about 2 minutes on one thread
+    python benchmarks/spd_speed.py                       # about 4 minutes on one thread
     python benchmarks/spd_speed.py --sections dtw --repeats 5
     python benchmarks/spd_speed.py --sections rlasa --shared-data ../shared/data
     python benchmarks/spd_speed.py --sections eigh
@@ -16,7 +16,8 @@ a warm-up call) and their ratio to R^3 measured in the same run:
     of each whitened pair).
 ``align``
     ``sk_rtw.align`` with its defaults and ``dba_average`` on N = 30 series of T = 100
-    samples: R^3 and SPD(2).
+    samples: R^3, SPD(2) (closed-form geometry) and SPD(3) (compiled Jacobi
+    eigendecompositions).
 ``eigh``
     How many LAPACK eigendecompositions (``torch.linalg.eigh`` and ``eigvalsh`` calls and
     the matrices in them) one ``align`` (20 epochs) makes on N = 10 series of T = 100
@@ -97,7 +98,7 @@ def align_rows(repeats: int) -> None:
         ("dba_average", lambda X, m: dba_average(X, manifold=m)),
     ):
         reference = None
-        for manifold in (Euclidean(3), SPD(2)):
+        for manifold in (Euclidean(3), SPD(2), SPD(3)):
             X = smooth_series(manifold, 30, 100)
             seconds = best_time(lambda X=X, m=manifold, fit=fit: fit(X, m), repeats)
             reference = reference or seconds

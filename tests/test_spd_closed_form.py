@@ -245,3 +245,73 @@ def test_the_manifold_uses_the_closed_form_and_agrees_with_a_larger_size():
     log = two._log(P, X)
     torch.testing.assert_close(_embed(log, 0.0), three._log(big_P, big_X))
     torch.testing.assert_close(_embed(two._exp(P, log), 1.0), three._exp(big_P, _embed(log, 0.0)))
+
+
+# ------------------------------------------------------------------ compiled Jacobi
+@pytest.mark.parametrize("k", [3, 4, 6])
+@pytest.mark.parametrize("spread", ["moderate", "wide", "indefinite"])
+def test_compiled_jacobi_matches_lapack(k, spread):
+    from sk_rtw.manifolds._symmetric import JACOBI_MAX_SIZE
+
+    assert k <= JACOBI_MAX_SIZE
+    rng = np.random.default_rng(k)
+    q, _ = np.linalg.qr(rng.standard_normal((300, k, k)))
+    if spread == "indefinite":
+        values = rng.standard_normal((300, k))
+    else:
+        values = 10.0 ** rng.uniform(-4, 4, (300, k)) if spread == "wide" else np.exp(
+            rng.standard_normal((300, k)))  # fmt: skip
+    S = torch.tensor((q * values[:, None, :]) @ np.swapaxes(q, 1, 2)).reshape(3, 100, k, k)
+    S = 0.5 * (S + S.mT)
+    w, U = eigh(S)
+    assert w.shape == (3, 100, k) and U.shape == (3, 100, k, k)
+    assert torch.all(w[..., :-1] <= w[..., 1:])
+    scale = S.abs().amax(dim=(-2, -1))
+    torch.testing.assert_close(w, torch.linalg.eigvalsh(S), rtol=0,
+                               atol=float(1e-14 * scale.max()))  # fmt: skip
+    torch.testing.assert_close(U.mT @ U, torch.eye(k, dtype=S.dtype).expand_as(S))
+    rebuilt = (U * w.unsqueeze(-2)) @ U.mT
+    assert float(((rebuilt - S).abs().amax(dim=(-2, -1)) / scale).max()) < 1e-14
+    if spread != "indefinite":  # positive definite: eigenvalues to high relative accuracy
+        exact = np.sort(values, 1).reshape(3, 100, k)
+        assert float((abs(w.numpy() - exact) / exact).max()) < 1e-8
+
+
+def test_compiled_jacobi_on_repeated_and_diagonal_spectra():
+    spread = torch.diag(torch.tensor([3.0, 1e-12, 1e12]))
+    S = torch.stack([torch.eye(3), 2.0 * torch.eye(3), spread, torch.zeros(3, 3)]).double()
+    w, U = eigh(S)
+    expected = torch.tensor([[1.0] * 3, [2.0] * 3, [1e-12, 3.0, 1e12], [0.0] * 3]).double()
+    assert torch.equal(w, expected)
+    assert torch.equal((U * w.unsqueeze(-2)) @ U.mT, S)
+
+
+def test_what_jacobi_does_not_converge_on_goes_to_lapack():
+    """NaN makes every sweep rotate: the matrix is handed to LAPACK, whose answer it gets
+    (the others keep Jacobi's)."""
+    S = torch.eye(3, dtype=torch.float64).repeat(2, 1, 1)
+    S[1, 0, 1] = S[1, 1, 0] = float("nan")
+    w, U = eigh(S)
+    w_lapack, U_lapack = torch.linalg.eigh(S[1])
+    torch.testing.assert_close(w[1], w_lapack, equal_nan=True)
+    torch.testing.assert_close(U[1], U_lapack, equal_nan=True)
+    assert torch.equal(w[0], torch.ones(3, dtype=torch.float64))
+
+
+def test_spd3_geometry_and_gradients_through_jacobi_match_lapack():
+    rng = np.random.default_rng(12)
+    q, _ = np.linalg.qr(rng.standard_normal((2, 40, 3, 3)))
+    P, X = (torch.tensor((q[i] * np.exp(rng.standard_normal((40, 1, 3)))) @ q[i].swapaxes(1, 2))
+            for i in range(2))  # fmt: skip
+    P, X = (0.5 * (P + P.mT)).requires_grad_(), (0.5 * (X + X.mT)).requires_grad_()
+    M = SPD(3)
+    weights = torch.tensor(rng.standard_normal((40, 3, 3)))
+    for ours, reference, weight in ((M._log, _lapack_log, weights),
+                                    (M._dist, _lapack_dist, weights[:, 0, 0])):  # fmt: skip
+        torch.testing.assert_close(ours(P, X), reference(P, X), rtol=1e-12, atol=1e-13)
+        mine = torch.autograd.grad((weight * ours(P, X)).sum(), (P, X))
+        theirs = torch.autograd.grad((weight * reference(P, X)).sum(), (P, X))
+        for a, b in zip(mine, theirs, strict=True):
+            torch.testing.assert_close(a, b, rtol=1e-9, atol=1e-11)
+    same = P.detach().clone().requires_grad_()
+    assert torch.autograd.gradcheck(lambda x: M._dist(P.detach(), x).pow(2).sum(), (same,))

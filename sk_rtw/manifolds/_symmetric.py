@@ -9,13 +9,17 @@ which stays finite when eigenvalues coincide.
 
 Several functions of the same matrices (``sqrt`` and ``invsqrt`` of a tangent point) share
 one decomposition. ``2 x 2`` matrices are decomposed in closed form by one Jacobi rotation
-(elementwise operations over the whole batch, on any device); ``torch.linalg.eigh`` runs a
-LAPACK call per matrix, whose overhead is most of the cost at this size.
+(elementwise operations over the whole batch, on any device), ``3 x 3`` to ``6 x 6`` on the
+CPU by the compiled cyclic Jacobi method (:mod:`~sk_rtw.manifolds._jacobi`);
+``torch.linalg.eigh`` runs a LAPACK call per matrix, whose overhead is most of the cost at
+these sizes.
 """
 
 from __future__ import annotations
 
 import torch
+
+from ._jacobi import jacobi_eigh
 
 _NAMES = ("exp", "log", "sqrt", "invsqrt")
 
@@ -83,11 +87,38 @@ def _eigh_2x2(S: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
     return w, torch.stack((lower, upper), -1)
 
 
+#: Largest size decomposed by the compiled Jacobi method on the CPU (3 x 3: a fifth of a
+#: LAPACK call's time per matrix, 6 x 6 still ahead, beyond that LAPACK).
+JACOBI_MAX_SIZE = 6
+
+
+def _compiled(S: torch.Tensor) -> bool:
+    return (
+        3 <= S.shape[-1] <= JACOBI_MAX_SIZE and S.device.type == "cpu" and S.dtype == torch.float64
+    )
+
+
+def _eigh_jacobi(S: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+    """:func:`~sk_rtw.manifolds._jacobi.jacobi_eigh` over a batch; a matrix it does not
+    converge on (NaN among them) goes to LAPACK, which answers or raises as before."""
+    k = S.shape[-1]
+    flat = S.detach().reshape(-1, k, k).contiguous()
+    w = torch.empty(flat.shape[:-1], dtype=S.dtype)
+    U = torch.empty_like(flat)
+    failed = torch.from_numpy(jacobi_eigh(flat.numpy(), w.numpy(), U.numpy()))
+    if bool(failed.any()):
+        w[failed], U[failed] = torch.linalg.eigh(flat[failed])
+    return w.reshape(S.shape[:-1]), U.reshape(S.shape)
+
+
 def eigh(S: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
     """Ascending eigenvalues and orthonormal eigenvectors (columns) of symmetric ``S``; no
-    gradient (the callers' backward passes use them)."""
+    gradient (the callers' backward passes use them). ``2 x 2`` in closed form, up to
+    ``JACOBI_MAX_SIZE`` compiled on the CPU, else LAPACK."""
     if S.shape[-1] == 2:
         return _eigh_2x2(S)
+    if _compiled(S):
+        return _eigh_jacobi(S)
     return torch.linalg.eigh(S)
 
 
@@ -117,11 +148,11 @@ class _SymmetricFunctions(torch.autograd.Function):
 
 
 class _Eigenvalues(torch.autograd.Function):
-    """Eigenvalues of symmetric ``2 x 2`` matrices; gradient ``U diag(g) U^T``."""
+    """Eigenvalues from :func:`eigh`; gradient ``U diag(g) U^T``."""
 
     @staticmethod
     def forward(ctx, S: torch.Tensor):
-        w, U = _eigh_2x2(S)
+        w, U = eigh(S)
         ctx.save_for_backward(U)
         return w
 
@@ -149,7 +180,7 @@ def eigenvalues(S: torch.Tensor) -> torch.Tensor:
     """Ascending eigenvalues of symmetric matrices ``S`` (..., k, k), differentiable (the
     gradient of a function of distinct or repeated eigenvalues stays finite)."""
     S = sym(S)
-    if S.shape[-1] == 2:
+    if S.shape[-1] == 2 or _compiled(S):
         return _Eigenvalues.apply(S)
     return torch.linalg.eigvalsh(S)
 
