@@ -12,6 +12,8 @@ import argparse
 import os
 import platform
 import tempfile
+import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -94,3 +96,15 @@ def machine(device: str = "cpu") -> str:
         f"{platform.machine()}, {os.cpu_count()} cores, torch {torch.__version__}, "
         f"Python {platform.python_version()}, device {device}"
     )
+
+
+def best_time(call: Callable[[], object], repeats: int, *, warm_up: bool = False) -> float:
+    """The least wall time of ``repeats`` calls (after one untimed call if ``warm_up``)."""
+    if warm_up:
+        call()
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        call()
+        times.append(time.perf_counter() - start)
+    return min(times)

@@ -14,21 +14,16 @@ from __future__ import annotations
 
 import argparse
 import platform
-import time
+import sys
+from pathlib import Path
 
 import numpy as np
 from aeon.distances import dtw_pairwise_distance as aeon_pairwise
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the repository; then _shared
+
+from benchmarks._shared import best_time
 from sk_rtw.dtw import dtw_pairwise_distance
-
-
-def best_time(fn, repeats: int) -> float:
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - start)
-    return min(times)
 
 
 def main(argv=None) -> None:

@@ -47,23 +47,12 @@ import torch
 # there is the one measured
 sys.path.append(str(Path(__file__).resolve().parents[1]))
 
-from benchmarks._shared import machine, positive_int
+from benchmarks._shared import best_time, machine, positive_int
 from sk_rtw import RTWNearestCentroid, align, dtw_pairwise_distance
 from sk_rtw.baselines import dba_average
 from sk_rtw.manifolds import SPD, Euclidean
 
 SECTIONS = ("dtw", "align", "rlasa", "eigh")
-
-
-def best_time(call, repeats: int) -> float:
-    """The least wall time of ``repeats`` calls, after one warm-up call."""
-    call()
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        call()
-        times.append(time.perf_counter() - start)
-    return min(times)
 
 
 def smooth_series(manifold, n_series: int, length: int, seed: int = 0) -> np.ndarray:
@@ -85,7 +74,7 @@ def dtw_rows(repeats: int) -> None:
     for manifold in (Euclidean(3), SPD(2), SPD(3), SPD(8)):
         X = smooth_series(manifold, 8, 200)
         seconds = best_time(lambda X=X, m=manifold: dtw_pairwise_distance(X, manifold=m),
-                            repeats)  # fmt: skip
+                            repeats, warm_up=True)  # fmt: skip
         reference = reference or seconds
         print(f"  {manifold!r:>14}: {seconds * 1e3:8.1f} ms, {seconds / reference:6.1f}x R^3",
               flush=True)  # fmt: skip
@@ -100,7 +89,7 @@ def align_rows(repeats: int) -> None:
         reference = None
         for manifold in (Euclidean(3), SPD(2), SPD(3)):
             X = smooth_series(manifold, 30, 100)
-            seconds = best_time(lambda X=X, m=manifold, fit=fit: fit(X, m), repeats)
+            seconds = best_time(lambda X=X, m=manifold, fit=fit: fit(X, m), repeats, warm_up=True)
             reference = reference or seconds
             print(f"  {label} {manifold!r:>14}: {seconds:7.2f} s, {seconds / reference:6.1f}x "
                   "R^3", flush=True)  # fmt: skip

@@ -94,6 +94,12 @@ def safe_norm(v: torch.Tensor, dim: int | tuple[int, ...] = -1) -> torch.Tensor:
         sq = sum_last(v * v, n_axes=2)
     else:
         sq = (v * v).sum(dim=dim)
+    return safe_sqrt(sq)
+
+
+def safe_sqrt(sq: torch.Tensor) -> torch.Tensor:
+    """Square root of non-negative ``sq`` whose gradient at zero is zero instead of
+    infinite (NaN stays NaN)."""
     positive = sq > 0
     root = torch.sqrt(torch.where(positive, sq, torch.ones_like(sq)))
     return torch.where(positive, root, sq * 0.0)  # 0 at 0, NaN for NaN

@@ -9,9 +9,9 @@ it and store only what they compute (:func:`_pruned_row`): the result is the sam
 Point distances that numba computes itself are described by "segments" ``(start, stop,
 code)`` of a flattened point, translated by :func:`segment_codes` from the manifold's
 :attr:`~sk_rtw.manifolds.Manifold.distance_segments`: code 0 Euclidean, 1 great-circle on
-a sphere, 2 sign-invariant great circle (quaternions), 3 and 4 affine-invariant SPD(2)
-and SPD(3) (:mod:`~sk_rtw.dtw._spd_kernels`); a product space is several segments,
-combined as ``sqrt(sum d_s^2)``. The kernels read points in their kernel form
+a sphere, 2 sign-invariant great circle (quaternions), ``k + 1`` affine-invariant SPD(k)
+for ``2 <= k <= MAX_KERNEL_SIZE`` (:mod:`~sk_rtw.dtw._spd_kernels`); a product space is
+several segments, combined as ``sqrt(sum d_s^2)``. The kernels read points in their kernel form
 (:func:`kernel_points`): the coordinates as they are, except an SPD block, which becomes
 its features (prepared once per point, so that a pair costs no eigendecomposition).
 """

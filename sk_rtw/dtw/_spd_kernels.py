@@ -41,8 +41,6 @@ from numba import njit
 #: tridiagonalisation and implicit QL in compiled code beat a batched LAPACK call per
 #: pair (whose overhead dominates at this size); beyond it LAPACK's blocked code wins.
 MAX_KERNEL_SIZE = 12
-
-
 _TWO_THIRDS_PI = 2.0 * math.pi / 3.0
 
 
@@ -173,7 +171,6 @@ def spd_features(points, k):
     return out
 
 
-
 @njit(cache=True, nogil=True, inline="always")
 def spd_log_eigenvalues2(x, y, s):
     """Log generalized eigenvalues ``(large, small)`` of the pair of 2 x 2 points whose
@@ -236,16 +233,15 @@ def spd_squared_distance(x, y, s, k):
 def _general_features(points, k, out):
     """:func:`spd_features` for ``k > 3``: the Cholesky factor's inverse by forward
     substitution, the log-eigenvalues by :func:`_symmetric_eigenvalues`."""
-    work = np.empty((k, k))
+    work, A, L = np.empty((k, k)), np.empty((k, k)), np.empty((k, k))
     diagonal, off = np.empty(k), np.empty(k)
     inverse_start, point_start = k, k + k * (k + 1) // 2
     for t in range(points.shape[0]):
         f = out[t]
-        A = np.empty((k, k))
         for i in range(k):
             for j in range(k):
                 A[i, j] = 0.5 * (points[t, i * k + j] + points[t, j * k + i])
-        L = np.zeros((k, k))  # Cholesky, lower; NaN when not positive definite
+        # Cholesky, lower triangle (the only one read); NaN when not positive definite
         for j in range(k):
             total = A[j, j]
             for m in range(j):
@@ -363,7 +359,6 @@ def _symmetric_eigenvalues(a, n, d, e):
                         a[j, m] -= f * e[m] + g * a[i, m]
         else:
             e[i] = a[i, last]
-        d[i] = h
     for i in range(n):
         d[i] = a[i, i]
     for i in range(1, n):

@@ -129,7 +129,7 @@ class Manifold(ABC):
         affine-invariant distance of a row-major SPD matrix; the distance of a point is
         ``sqrt(sum_s d_s^2)`` over the blocks. None when the distance has no such form:
         computations that need it (the DTW kernels) then use :meth:`pairwise_dist`, as
-        they do for the kinds they have no kernel for (SPD matrices larger than 3 x 3).
+        they do for the kinds they have no kernel for (SPD matrices larger than 12 x 12).
         A statement about the geometry only: how a consumer computes these distances is
         its own business.
         """

@@ -22,6 +22,7 @@ from typing import NamedTuple
 
 import torch
 
+from .._backend import safe_sqrt
 from ._symmetric import distinct
 
 #: Below this ``r^2`` (``exp``) or ``(r / m)^2`` (``log``, distance) the even functions of
@@ -188,7 +189,4 @@ def squared_dist(p: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
 
 def dist(p: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
     """Affine-invariant distance; its gradient at ``X = P`` is zero, not NaN."""
-    sq = squared_dist(p, x)
-    positive = sq > 0
-    root = torch.sqrt(torch.where(positive, sq, torch.ones_like(sq)))
-    return torch.where(positive, root, sq * 0.0)
+    return safe_sqrt(squared_dist(p, x))
