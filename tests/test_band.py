@@ -65,3 +65,96 @@ def test_halving_takes_geodesic_midpoints():
     x = np.stack([np.cos(angles), np.sin(angles)], 1)
     mid = halve(x, S1)
     np.testing.assert_allclose(np.arctan2(mid[:, 1], mid[:, 0]), [0.2, 1.1, 2.0], atol=1e-12)
+
+
+def _reference_band_dtw(cost, lo, hi):
+    """The DTW recursion in plain Python with ``inf`` outside the band, and the path
+    backtracked with ties broken diagonal, then up, then left."""
+    nx, ny = cost.shape
+    D = np.full((nx + 1, ny + 1), np.inf)
+    D[0, 0] = 0.0
+    for i in range(nx):
+        for j in range(lo[i], hi[i]):
+            D[i + 1, j + 1] = cost[i, j] + min(D[i, j], D[i, j + 1], D[i + 1, j])
+    i, j, path = nx - 1, ny - 1, [(nx - 1, ny - 1)]
+    while i > 0 or j > 0:
+        if i == 0:
+            j -= 1
+        elif j == 0:
+            i -= 1
+        else:
+            diag, up, left = D[i, j], D[i, j + 1], D[i + 1, j]
+            if diag <= up and diag <= left:
+                i, j = i - 1, j - 1
+            elif up <= left:
+                i -= 1
+            else:
+                j -= 1
+        path.append((i, j))
+    return D[1:, 1:], np.array(path[::-1])
+
+
+@pytest.mark.parametrize("compiled", [True, False], ids=["kernel costs", "given costs"])
+def test_band_rows_match_a_reference_recursion(compiled, rng):
+    from sk_rtw.dtw import point_cost_matrix
+    from sk_rtw.dtw._costs import kernel_form
+    from sk_rtw.dtw._kernels import (
+        band_accumulated_cost,
+        band_segment_cost,
+        ragged_backtrack,
+        ragged_value,
+        segment_codes,
+    )
+
+    manifold = Sphere(2)
+    x = manifold.project(rng.standard_normal((41, 3)))
+    y = manifold.project(rng.standard_normal((37, 3)))
+    coarse = [(0, 0)]  # a warping path of the half-length problem, random steps
+    while coarse[-1] != (20, 18):
+        i, j = coarse[-1]
+        step = [(1, 1), (1, 0), (0, 1)][rng.integers(3)]
+        coarse.append((min(i + step[0], 20), min(j + step[1], 18)))
+    coarse = np.array(coarse)
+    lo, hi = band_from_path(coarse, len(x), len(y), 2)
+    cost = np.round(point_cost_matrix(x, y, manifold, squared=True), 1)  # ties on purpose
+    if compiled:
+        cost = point_cost_matrix(x, y, manifold, squared=True)
+        rows = band_segment_cost(kernel_form(x, manifold), kernel_form(y, manifold),
+                                 segment_codes(manifold), True, lo, hi)  # fmt: skip
+    else:
+        band_values = np.concatenate([cost[i, lo[i] : hi[i]] for i in range(len(x))])
+        rows = band_accumulated_cost(band_values, lo, hi)
+    D, path = _reference_band_dtw(cost, lo, hi)
+    for i in range(len(x)):
+        for j in range(len(y)):
+            expected = D[i, j] if lo[i] <= j < hi[i] else np.inf
+            assert ragged_value(*rows, i, j) == expected
+    np.testing.assert_array_equal(ragged_backtrack(*rows, len(y)), path)
+
+
+def test_mean_matched_positions_are_the_paths_mean_positions(rng):
+    from sk_rtw.dtw import has_compiled_costs, mean_matched_positions
+
+    manifold = Euclidean(2)
+    references = [rng.standard_normal((n, 2)).cumsum(0) for n in (30, 24)]
+    series = [rng.standard_normal((n, 2)).cumsum(0) for n in (28, 35, 19)]
+    codes = np.array([0, 1, 0])
+
+    def padded(arrays):
+        out = np.stack([np.concatenate([a, np.repeat(a[-1:], 35 - len(a), 0)]) for a in arrays])
+        return out
+
+    assert has_compiled_costs(manifold) and not has_compiled_costs(SPD(13))
+    positions = mean_matched_positions(
+        padded(references), np.array([30, 24]), padded(series), np.array([28, 35, 19]), codes,
+        manifold, window=0.5,
+    )  # fmt: skip
+    for n, s in enumerate(series):
+        reference = references[codes[n]]
+        path, _ = path_indices(reference, s, manifold, 0.5, squared=True)
+        expected = [path[path[:, 0] == i, 1].mean() for i in range(len(reference))]
+        np.testing.assert_allclose(positions[n, : len(reference)], expected, rtol=0, atol=1e-12)
+        assert not positions[n, len(reference) :].any()
+    with pytest.raises(ValueError, match="no compiled point costs"):
+        mean_matched_positions(padded(references), np.array([30, 24]), padded(series),
+                               np.array([28, 35, 19]), codes, SPD(13))  # fmt: skip

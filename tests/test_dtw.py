@@ -225,8 +225,7 @@ def test_paths_with_costs_computed_inside_the_accumulation_equal_the_full_matrix
     """path_indices computes the point costs row by row inside the band; the full cost
     matrix gives the same path and cost, bit for bit."""
     from sk_rtw.datasets import make_warped_signals
-    from sk_rtw.dtw._dtw import point_cost_matrix
-    from sk_rtw.dtw._paths import optimal_path, path_indices
+    from sk_rtw.dtw import optimal_path, path_indices, point_cost_matrix
     from sk_rtw.manifolds import Euclidean, Product, Quaternion
 
     rng = np.random.default_rng(3)
@@ -262,8 +261,8 @@ def test_a_guide_path_skips_cells_without_changing_the_path_or_cost(name):
     band: recomputed), and a close guide skips most cells and stores only what it
     computed."""
     from sk_rtw.datasets import make_warped_signals
-    from sk_rtw.dtw import _kernels
-    from sk_rtw.dtw._dtw import _flat, point_cost_matrix
+    from sk_rtw.dtw import _kernels, point_cost_matrix
+    from sk_rtw.dtw._costs import flat_points as _flat
     from sk_rtw.dtw._paths import path_indices
 
     data = make_warped_signals(name, 2, 300, random_state=4)

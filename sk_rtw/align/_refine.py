@@ -6,7 +6,7 @@ improved by moving its points directly. The objective is the soft-DTW barycentre
 point costs, on any manifold. Because soft-DTW is concave in the cost matrix, the
 linearisation at the current mean majorises ``F``: minimising it is, for every sample
 ``y_i``, the weighted Fréchet mean of all the samples ``x_n[j]`` with the soft alignment
-weights ``E_n[i, j]`` (:mod:`sk_rtw.dtw._soft`). Each step is therefore the manifold's
+weights ``E_n[i, j]`` (:func:`sk_rtw.dtw.soft_dtw_batch`). Each step is therefore the manifold's
 weighted mean (the one kernel, :func:`sk_rtw.manifolds._mean.frechet_mean`), never
 increases ``F``, and as ``gamma -> 0`` is DBA's update; a larger ``gamma`` lets a sample
 be pulled by the near-ties that DBA's hard path ignores. ``gamma`` runs down a schedule
@@ -26,9 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 import torch
 
-from ..dtw import dtw_pairwise_distance
-from ..dtw._dtw import point_cost_matrix
-from ..dtw._soft import soft_dtw_batch
+from ..dtw import dtw_pairwise_distance, point_cost_matrix, soft_dtw_batch
 from ..manifolds import Manifold
 from ..manifolds._mean import frechet_mean
 

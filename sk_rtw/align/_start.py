@@ -8,7 +8,7 @@ off DTW paths (docs: class means). The DTW start:
    :data:`MEDOID_CANDIDATES` series drawn with the fit's random generator (on copies
    halved in length where the all-pairs DTW would exceed :data:`MEDOID_CELLS` cells);
 2. for every series the DTW path to the reference (coarse to fine in a band for long
-   pairs, :func:`sk_rtw.dtw._band.multiscale_path`); the warp at reference sample ``l``
+   pairs, :func:`sk_rtw.dtw.multiscale_path`); the warp at reference sample ``l``
    is the mean index of the series samples matched with it, as a relative position in
    [0, 1], made non-decreasing, with the ends at 0 and 1, and smoothed by a Gaussian of
    :data:`SMOOTHING` samples (monotonicity and ends kept);
@@ -33,9 +33,16 @@ from collections.abc import Callable
 import numpy as np
 import torch
 
-from ..dtw import check_window, medoid_index, path_indices
-from ..dtw._band import coarse_collection, multiscale_path, solved_exactly
-from ..dtw._kernels import kernel_points, matched_positions, segment_codes
+from ..dtw import (
+    check_window,
+    coarse_collection,
+    has_compiled_costs,
+    mean_matched_positions,
+    medoid_index,
+    multiscale_path,
+    path_indices,
+    solved_exactly,
+)
 from ..manifolds import Manifold
 from ..utils import SeriesCollection
 from ._layout import GroupLayout
@@ -266,16 +273,16 @@ def _path_warps(
     its group: in a band if ``window`` is given, else coarse to fine for long pairs.
 
     The pairs whose path is exact (a band, or short enough for
-    :func:`~sk_rtw.dtw._band.multiscale_path` to solve them exactly) go through one
-    compiled pass (:func:`~sk_rtw.dtw._kernels.matched_positions`: the same paths, no
+    :func:`~sk_rtw.dtw.multiscale_path` to solve them exactly) go through one
+    compiled pass (:func:`~sk_rtw.dtw.mean_matched_positions`: the same paths, no
     Python per pair); the others one by one. ``stacked``: the same series as one padded
     ``(N, T_max, p)`` array and their lengths.
     """
     band = check_window(window)
-    segments = segment_codes(manifold)
+    compiled = has_compiled_costs(manifold)
     exact = [
         n for n, s in enumerate(series)
-        if segments is not None
+        if compiled
         and ((0.0 <= band < 1.0) or solved_exactly(len(references[codes[n]]), len(s)))
     ]  # fmt: skip
     warps: list[np.ndarray] = [np.empty(0)] * len(series)
@@ -284,10 +291,9 @@ def _path_warps(
         # padding read as the last sample (on the manifold), then the kernels' form
         last = np.minimum(np.arange(stacked[0].shape[1]), lengths[:, None] - 1)
         padded = np.take_along_axis(stacked[0][exact], last[:, :, None], axis=1)
-        positions = matched_positions(
-            kernel_points(manifold, _stack(references)), np.array([len(r) for r in references]),
-            np.ascontiguousarray(kernel_points(manifold, padded)), lengths, codes[exact],
-            segments, True, band,
+        positions = mean_matched_positions(
+            _stack(references), np.array([len(r) for r in references]), padded, lengths,
+            codes[exact], manifold, band, squared=True,
         )  # fmt: skip
         for row, n in enumerate(exact):
             length = len(references[codes[n]])

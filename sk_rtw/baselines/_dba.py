@@ -8,8 +8,7 @@ from typing import Any
 import numpy as np
 import torch
 
-from ..dtw import check_window, medoid_index, path_indices
-from ..dtw._band import coarse_collection
+from ..dtw import check_window, coarse_collection, medoid_index, path_indices
 from ..manifolds import Manifold
 from ..manifolds._mean import frechet_mean
 from ..utils import check_series_collection

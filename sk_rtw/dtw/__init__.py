@@ -1,35 +1,47 @@
 """Dynamic time warping with geodesic point costs on any manifold.
 
 Besides the distances, the helpers that the DTW-family baselines and the alignment
-engine share: :func:`check_window` (the Sakoe–Chiba argument), :func:`optimal_path` (a
-path through a point-cost matrix), :func:`path_indices` (the path between two series) and
-:func:`medoid_index` (the DTW medoid of a collection), and :func:`multiscale_path` (a
-coarse-to-fine banded path for long series). :func:`dtw_nearest_distance` finds the
-nearest series of every group with lower bounds and early abandoning.
+engine share (this package's ``__init__`` is their only door to it):
+:func:`check_window` (the Sakoe–Chiba argument), :func:`point_cost_matrix` and
+:func:`optimal_path` (a path through a point-cost matrix), :func:`path_indices` (the path
+between two series), :func:`mean_matched_positions` (the mean matched positions of many
+pairs in one compiled pass, for manifolds with :func:`has_compiled_costs`),
+:func:`medoid_index` (the DTW medoid of a collection), :func:`multiscale_path` (a
+coarse-to-fine banded path for long series, exact below the size
+:func:`solved_exactly` tells), :func:`coarse_collection` (series halved by geodesic
+midpoints) and :func:`soft_dtw_batch` (soft-DTW values and expected alignments).
+:func:`dtw_nearest_distance` finds the nearest series of every group with lower bounds
+and early abandoning.
+
+The modules stand on floors, each importing only those below it: the compiled kernels
+(``_kernels``, ``_spd_kernels``, ``_soft``); point costs and the optimal path through
+them (``_costs``); the coarse-to-fine band (``_band``); paths between series
+(``_paths``); the distances (``_dtw``); their consumers (``_medoid``, ``_search``).
 """
 
-from ._band import multiscale_path
-from ._dtw import (
-    check_window,
-    dtw_cost_matrix,
-    dtw_distance,
-    dtw_pairwise_distance,
-    dtw_path,
-    point_cost_matrix,
-)
-from ._paths import medoid_index, optimal_path, path_indices
+from ._band import coarse_collection, multiscale_path, solved_exactly
+from ._costs import optimal_path, point_cost_matrix
+from ._dtw import check_window, dtw_cost_matrix, dtw_distance, dtw_pairwise_distance, dtw_path
+from ._medoid import medoid_index
+from ._paths import has_compiled_costs, mean_matched_positions, path_indices
 from ._search import dtw_nearest_distance
+from ._soft import soft_dtw_batch
 
 __all__ = [
     "check_window",
+    "coarse_collection",
     "dtw_cost_matrix",
     "dtw_distance",
     "dtw_nearest_distance",
     "dtw_pairwise_distance",
     "dtw_path",
+    "has_compiled_costs",
+    "mean_matched_positions",
     "medoid_index",
     "multiscale_path",
     "optimal_path",
     "path_indices",
     "point_cost_matrix",
+    "soft_dtw_batch",
+    "solved_exactly",
 ]

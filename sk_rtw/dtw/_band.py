@@ -10,9 +10,11 @@ onto it: ``O((T_x + T_y) radius)`` cells per level. The path is optimal within t
 in the rare case that the optimal path leaves the band it is a close approximation
 (tests compare both with the exact path).
 
-Band layout: row ``i`` holds the columns ``lo[i] <= j < hi[i]``, stored at ``j - lo[i]``
-in an array of ``(T_x, max(hi - lo))`` values; ``lo`` and ``hi`` are non-decreasing, so
-the band is a staircase that connects ``(0, 0)`` with ``(T_x - 1, T_y - 1)``.
+Band layout: row ``i`` holds the columns ``lo[i] <= j < hi[i]``; ``lo`` and ``hi`` are
+non-decreasing, so the band is a staircase that connects ``(0, 0)`` with
+``(T_x - 1, T_y - 1)``. The recursion, its storage by rows and the tie rule on the way
+back are the kernels' (:func:`~._kernels.band_segment_cost`,
+:func:`~._kernels.ragged_backtrack`), as for every other DTW path of the package.
 """
 
 from __future__ import annotations
@@ -22,9 +24,9 @@ import torch
 from numba import njit
 
 from ..manifolds import Manifold
+from ..utils import SeriesCollection
 from . import _kernels
-
-_INF = np.inf
+from ._costs import kernel_form, optimal_path, point_cost_matrix
 
 #: Pairs with at most this many cells get the exact path.
 EXACT_CELLS = 2**20
@@ -63,75 +65,6 @@ def band_from_path(path, nx, ny, radius):
     return lo, hi
 
 
-@njit(cache=True, nogil=True)
-def band_segment_costs(x, y, lo, hi, segments, squared, width):
-    """Point costs of the band cells for manifolds with kernel distances (segments)."""
-    nx = x.shape[0]
-    out = np.full((nx, width), _INF)
-    for i in range(nx):
-        _kernels._cost_row(x, y[lo[i] : hi[i]], i, hi[i] - lo[i], segments, squared, out[i])
-    return out
-
-
-@njit(cache=True, nogil=True)
-def band_accumulate(cost, lo, hi):
-    """Accumulated DTW cost of the band cells (``inf`` outside the band)."""
-    nx, width = cost.shape
-    D = np.full((nx, width), _INF)
-    for i in range(nx):
-        for j in range(lo[i], hi[i]):
-            c = cost[i, j - lo[i]]
-            if i == 0 and j == 0:
-                D[0, 0] = c
-                continue
-            best = _INF
-            if i > 0:
-                if lo[i - 1] <= j < hi[i - 1]:
-                    best = D[i - 1, j - lo[i - 1]]
-                if lo[i - 1] <= j - 1 < hi[i - 1] and D[i - 1, j - 1 - lo[i - 1]] < best:
-                    best = D[i - 1, j - 1 - lo[i - 1]]
-            if j - 1 >= lo[i] and D[i, j - 1 - lo[i]] < best:
-                best = D[i, j - 1 - lo[i]]
-            D[i, j - lo[i]] = c + best
-    return D
-
-
-@njit(cache=True, nogil=True)
-def _band_value(D, lo, hi, i, j):
-    if j < lo[i] or j >= hi[i]:
-        return _INF
-    return D[i, j - lo[i]]
-
-
-@njit(cache=True, nogil=True)
-def band_backtrack(D, lo, hi):
-    """Optimal path ``(P, 2)`` through a band (ties as the dense recursion breaks them)."""
-    nx = D.shape[0]
-    i, j = nx - 1, hi[nx - 1] - 1
-    out = np.empty((nx + j + 1, 2), dtype=np.int64)
-    n = 0
-    out[n, 0], out[n, 1] = i, j
-    n += 1
-    while i > 0 or j > 0:
-        if i == 0:
-            j -= 1
-        elif j == 0:
-            i -= 1
-        else:
-            diag = _band_value(D, lo, hi, i - 1, j - 1)
-            up = _band_value(D, lo, hi, i - 1, j)
-            left = _band_value(D, lo, hi, i, j - 1)
-            if diag <= up and diag <= left:
-                i, j = i - 1, j - 1
-            elif up <= left:
-                i -= 1
-            else:
-                j -= 1
-        out[n, 0], out[n, 1] = i, j
-        n += 1
-    return out[:n][::-1].copy()
-
-
 def halve(series: np.ndarray, manifold: Manifold) -> np.ndarray:
     """Geodesic midpoints of samples ``2k`` and ``2k + 1`` (an odd last sample is kept)."""
     n = len(series)
@@ -152,10 +85,23 @@ def coarse(series: np.ndarray, manifold: Manifold, length: int) -> np.ndarray:
 
 
 def coarse_collection(series: list[np.ndarray], manifold: Manifold, length: int):
-    """Every series :func:`coarse` to at most ``length`` samples, as one collection (the
-    shorter ones padded with their last sample, their lengths kept)."""
-    from ..utils import SeriesCollection
+    """Series halved by geodesic midpoints of neighbouring samples until each has at most
+    ``length`` samples, as one collection.
 
+    Parameters
+    ----------
+    series : list of ndarray of shape (T_i, *point_shape)
+        Validated series on ``manifold``.
+    manifold : Manifold
+    length : int
+        The most samples a coarse series keeps.
+
+    Returns
+    -------
+    SeriesCollection
+        The coarse series, the shorter ones padded with their last sample (their lengths
+        kept).
+    """
     small = [coarse(s, manifold, length) for s in series]
     lengths = np.array([len(s) for s in small])
     data = np.stack(
@@ -164,25 +110,34 @@ def coarse_collection(series: list[np.ndarray], manifold: Manifold, length: int)
     return SeriesCollection(data=data, lengths=lengths, manifold=manifold)
 
 
-def _band_costs(x, y, lo, hi, manifold, squared) -> np.ndarray:
-    width = int((hi - lo).max())
+def _band_rows(x, y, lo, hi, manifold, squared):
+    """The accumulated cost of the band's cells, stored by rows (the kernels'
+    ``(values, offsets, starts)``)."""
     segments = _kernels.segment_codes(manifold)
     if segments is not None:
-        return band_segment_costs(_kernels.kernel_points(manifold, _flat(x)),
-                                  _kernels.kernel_points(manifold, _flat(y)), lo, hi, segments,
-                                  squared, width)  # fmt: skip
+        return _kernels.band_segment_cost(kernel_form(x, manifold), kernel_form(y, manifold),
+                                          segments, squared, lo, hi)  # fmt: skip
     rows = np.repeat(np.arange(len(x)), hi - lo)
-    offsets = np.arange(rows.size) - np.repeat(np.cumsum(hi - lo) - (hi - lo), hi - lo)
-    cols = lo[rows] + offsets
-    cost = np.full((len(x), width), np.inf)
+    cols = lo[rows] + np.arange(rows.size) - np.repeat(np.cumsum(hi - lo) - (hi - lo), hi - lo)
     with torch.no_grad():
         values = manifold._dist(torch.as_tensor(x[rows]), torch.as_tensor(y[cols])).numpy()
-    cost[rows, offsets] = values * values if squared else values
-    return cost
+    return _kernels.band_accumulated_cost(values * values if squared else values, lo, hi)
 
 
 def solved_exactly(nx: int, ny: int, radius: int = RADIUS, exact_cells: int = EXACT_CELLS):
-    """Whether :func:`multiscale_path` solves a pair of these lengths exactly (no band)."""
+    """Whether :func:`multiscale_path` solves a pair of these lengths exactly (no band).
+
+    Parameters
+    ----------
+    nx, ny : int
+        The two series' lengths.
+    radius, exact_cells : int
+        As in :func:`multiscale_path`.
+
+    Returns
+    -------
+    bool
+    """
     return nx * ny <= exact_cells or min(nx, ny) <= 2 * radius + 2
 
 
@@ -215,16 +170,14 @@ def multiscale_path(
     cost : float
         Accumulated cost along the path.
     """
-    from ._dtw import point_cost_matrix
-    from ._paths import optimal_path
-
     if solved_exactly(len(x), len(y), radius, exact_cells):
         return optimal_path(point_cost_matrix(x, y, manifold, squared))
     coarse, _ = multiscale_path(halve(x, manifold), halve(y, manifold), manifold, squared,
                                 radius, exact_cells)  # fmt: skip
     lo, hi = band_from_path(coarse, len(x), len(y), radius)
-    D = band_accumulate(_band_costs(x, y, lo, hi, manifold, squared), lo, hi)
-    return band_backtrack(D, lo, hi), float(D[-1, hi[-1] - 1 - lo[-1]])
+    rows = _band_rows(x, y, lo, hi, manifold, squared)
+    cost = _kernels.ragged_value(*rows, len(x) - 1, len(y) - 1)
+    return _kernels.ragged_backtrack(*rows, len(y)), float(cost)
 
 
 def guide_bound(
@@ -246,13 +199,6 @@ def guide_bound(
         guide = multiscale_path(x, y, manifold, squared)[0]
     if guide is None:
         return np.inf
-    cost = _kernels.path_cost(
-        _kernels.kernel_points(manifold, _flat(x)), _kernels.kernel_points(manifold, _flat(y)),
-        np.asarray(guide, dtype=np.int64), segments, squared,
-    )  # fmt: skip
+    cost = _kernels.path_cost(kernel_form(x, manifold), kernel_form(y, manifold),
+                              np.asarray(guide, dtype=np.int64), segments, squared)  # fmt: skip
     return cost * (1.0 + GUIDE_SLACK)
-
-
-def _flat(x: np.ndarray) -> np.ndarray:
-    """A validated series ``(T, *point_shape)`` as ``(T, prod(point_shape))``."""
-    return np.ascontiguousarray(x.reshape(x.shape[0], -1))

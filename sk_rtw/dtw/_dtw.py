@@ -16,7 +16,9 @@ from .._numba import numba_threads
 from ..manifolds import Manifold
 from ..utils import SeriesCollection, check_series, check_series_collection
 from . import _kernels
-from ._band import EXACT_CELLS, _flat, guide_bound
+from ._band import EXACT_CELLS, guide_bound
+from ._costs import check_costs, kernel_form, point_cost_matrix
+from ._paths import path_indices
 
 _NORMALIZE = (None, "path")
 
@@ -53,70 +55,10 @@ def _check_normalize(normalize: str | None) -> None:
         raise ValueError(f"normalize must be one of {_NORMALIZE}, got {normalize!r}")
 
 
-def point_cost_matrix(
-    x: np.ndarray, y: np.ndarray, manifold: Manifold, squared: bool = False
-) -> np.ndarray:
-    """Cost matrix ``C[i, j] = dist(x[i], y[j])`` (or its square) of two validated series.
-
-    Parameters
-    ----------
-    x : ndarray of shape (T_x, *point_shape)
-    y : ndarray of shape (T_y, *point_shape)
-    manifold : Manifold
-    squared : bool, default=False
-
-    Returns
-    -------
-    C : ndarray of shape (T_x, T_y)
-    """
-    segments = _kernels.segment_codes(manifold)
-    if segments is not None:
-        out = np.empty((len(x), len(y)))
-        _kernels.segment_cost_matrix(
-            _kernels.kernel_points(manifold, _flat(x)),
-            _kernels.kernel_points(manifold, _flat(y)),
-            len(x),
-            len(y),
-            segments,
-            squared,
-            out,
-        )
-        return out
-    cost = np.asarray(manifold.pairwise_dist(x, y))
-    check_costs(cost, manifold, points=(x, y))
-    return cost * cost if squared else cost
-
-
-def check_costs(
-    cost: np.ndarray, manifold: Manifold, x: str = "x", y: str = "y", points: tuple = ()
-) -> None:
-    """Refuse non-finite point costs (a manifold's ``dist`` that fails far from a point,
-    or geodesics that float64 cannot follow): DTW would return NaN, or a path that is not
-    optimal, without saying so.
-
-    ``cost`` is ``(T_x, T_y)``; ``x`` and ``y`` name the two series in the message, whose
-    samples ``points`` (the two series, optional; read only on failure) let the manifold
-    say what their range is.
-    """
-    bad = ~np.isfinite(cost)
-    if not bad.any():
-        return
-    i, j = (int(k) for k in np.argwhere(bad)[0])
-    note = manifold.spread_note(np.concatenate(points)) if points else ""
-    raise ValueError(
-        f"{manifold!r} gives the distance {cost[i, j]} between {x} at time {i} and {y} at "
-        f"time {j}, and {int(bad.sum())} non-finite point costs in all"
-        + (f" ({note})" if note else "")
-        + ": DTW needs finite distances between every pair of samples. Rescale the data, "
-        "or check the manifold's log and dist far from a point with "
-        "sk_rtw.check_manifold(manifold, points)"
-    )
-
-
 def _guide_bounds(
     cx: SeriesCollection, cy: SeriesCollection, window: float, squared: bool, symmetric: bool
 ) -> np.ndarray:
-    """:func:`~sk_rtw.dtw._band.guide_bound` of every pair (``inf`` where none: short
+    """:func:`~._band.guide_bound` of every pair (``inf`` where none: short
     pairs, a band; the upper triangle if ``symmetric``)."""
     bounds = np.full((cx.n_series, cy.n_series), np.inf)
     if cx.max_length * cy.max_length <= EXACT_CELLS or 0.0 <= window < 1.0:
@@ -202,7 +144,7 @@ def dtw_distance(
     w = check_window(window)
     x, y, manifold = _pair(x, y, manifold)
     if normalize == "path":
-        path, cost = _paths().path_indices(x, y, manifold, w, squared)
+        path, cost = path_indices(x, y, manifold, w, squared)
         return float(cost / len(path))
     segments = _kernels.segment_codes(manifold)
     if segments is None:
@@ -211,8 +153,7 @@ def dtw_distance(
     # two rows of memory; long pairs without a band skip the cells that cannot beat their
     # coarse-to-fine path (the same value)
     bound = guide_bound(x, y, manifold, w, squared)
-    fx = _kernels.kernel_points(manifold, _flat(x))
-    fy = _kernels.kernel_points(manifold, _flat(y))
+    fx, fy = kernel_form(x, manifold), kernel_form(y, manifold)
     value = _kernels.pruned_distance(fx, fy, segments, squared, w, bound)
     if not value <= bound:
         value = _kernels.pruned_distance(fx, fy, segments, squared, w, np.inf)
@@ -244,15 +185,8 @@ def dtw_path(
     """
     w = check_window(window)
     x, y, manifold = _pair(x, y, manifold)
-    path, cost = _paths().path_indices(x, y, manifold, w, squared)
+    path, cost = path_indices(x, y, manifold, w, squared)
     return [(int(i), int(j)) for i, j in path], cost
-
-
-def _paths():
-    """:mod:`sk_rtw.dtw._paths`, which builds on this module."""
-    from . import _paths
-
-    return _paths
 
 
 def dtw_pairwise_distance(

@@ -472,7 +472,36 @@ def accumulated_segment_cost(x, y, segments, squared, window, bound):
     Returns ``(values, offsets, starts)``: row ``i`` holds columns ``starts[i]`` onwards
     in ``values[offsets[i]:offsets[i + 1]]`` (:func:`ragged_value` reads a cell).
     """
-    return _pruned_rows(x, y, segments, squared, window, bound, True)[:3]
+    lo, hi = sakoe_chiba_rows(x.shape[0], y.shape[0], window)
+    return _pruned_rows(x, y, segments, squared, lo, hi, bound, True)[:3]
+
+
+@njit(cache=True, nogil=True)
+def band_segment_cost(x, y, segments, squared, lo, hi):
+    """:func:`accumulated_segment_cost` in any staircase band: row ``i`` holds the columns
+    ``lo[i] <= j < hi[i]`` (``lo`` and ``hi`` non-decreasing, ``lo[0] = 0``,
+    ``hi[-1] = len(y)``), every cell of it computed; the same ``(values, offsets,
+    starts)`` rows."""
+    return _pruned_rows(x, y, segments, squared, lo, hi, _INF, True)[:3]
+
+
+@njit(cache=True, nogil=True)
+def band_accumulated_cost(costs, lo, hi):
+    """:func:`band_segment_cost` from point costs computed elsewhere: ``costs`` holds the
+    band's cells row after row (row ``i``: columns ``lo[i]`` to ``hi[i] - 1``). Returns
+    the same ``(values, offsets, starts)`` rows (:func:`ragged_value` reads a cell)."""
+    nx, ny = lo.shape[0], hi[-1]
+    prev, cur = _two_rows(ny)
+    row = np.empty(ny)
+    values = np.empty(costs.shape[0])
+    offsets = np.zeros(nx + 1, dtype=np.int64)
+    for i in range(nx):
+        offsets[i + 1] = offsets[i] + hi[i] - lo[i]
+        row[lo[i] : hi[i]] = costs[offsets[i] : offsets[i + 1]]
+        _band_row(row, prev, cur, lo[i], hi[i])
+        values[offsets[i] : offsets[i + 1]] = cur[lo[i] + 1 : hi[i] + 1]
+        prev, cur = cur, prev
+    return values, offsets, lo.copy()
 
 
 @njit(cache=True, nogil=True)
@@ -491,15 +520,16 @@ def pruned_distance(x, y, segments, squared, window, bound):
             _band_row(costs, prev, cur, lo[i], hi[i])
             prev, cur = cur, prev
         return prev[y.shape[0]]
-    return _pruned_rows(x, y, segments, squared, window, bound, False)[3]
+    lo, hi = sakoe_chiba_rows(x.shape[0], y.shape[0], window)
+    return _pruned_rows(x, y, segments, squared, lo, hi, bound, False)[3]
 
 
 @njit(cache=True, nogil=True)
-def _pruned_rows(x, y, segments, squared, window, bound, store):
+def _pruned_rows(x, y, segments, squared, lo, hi, bound, store):
     """Rows of the accumulated cost in two buffers, each kept in ``values`` if ``store``:
-    ``(values, offsets, starts, last cell)`` (see :func:`accumulated_segment_cost`)."""
+    ``(values, offsets, starts, last cell)`` (see :func:`accumulated_segment_cost`), in
+    the staircase band ``[lo[i], hi[i])``."""
     nx, ny = x.shape[0], y.shape[0]
-    lo, hi = sakoe_chiba_rows(nx, ny, window)
     prev, cur = _two_rows(ny)
     costs = np.empty(ny)
     rows = nx if store else 0  # a distance alone allocates nothing per row

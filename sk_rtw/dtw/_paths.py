@@ -1,7 +1,5 @@
-"""DTW paths as index arrays, and the DTW medoid of a collection.
-
-Helpers shared by the DTW-family baselines and the engine's DTW start: they take series
-that are already validated (``(T, *point_shape)`` arrays on one manifold).
+"""DTW paths between validated series (``(T, *point_shape)`` arrays on one manifold),
+as index arrays or as the mean matched positions the alignment engine's start reads.
 """
 
 from __future__ import annotations
@@ -9,34 +7,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..manifolds import Manifold
-from ..utils import SeriesCollection
 from . import _kernels
-from ._band import _flat, guide_bound
-from ._dtw import dtw_pairwise_distance, point_cost_matrix
-
-
-def optimal_path(cost: np.ndarray, window: float = -1.0) -> tuple[np.ndarray, float]:
-    """Optimal DTW path through a point-cost matrix, and its accumulated cost.
-
-    Parameters
-    ----------
-    cost : ndarray of shape (T_x, T_y)
-        Point costs.
-    window : float, default=-1
-        Sakoe–Chiba radius as a fraction of the shorter series; negative: no band.
-
-    Returns
-    -------
-    path : ndarray of shape (P, 2), int
-        Index pairs ``(i, j)`` from ``(0, 0)`` to ``(T_x - 1, T_y - 1)``.
-    cost : float
-    """
-    D = _kernels.accumulated_cost(cost, window)
-    if not np.isfinite(D[-1, -1]):
-        if window < 0.0 or not np.isfinite(cost).all():
-            raise ValueError(f"the DTW cost is {D[-1, -1]}: the point costs are not finite")
-        raise ValueError("the Sakoe–Chiba window is too narrow to connect the series ends")
-    return np.asarray(_kernels.backtrack(D), dtype=np.int64).reshape(-1, 2), float(D[-1, -1])
+from ._band import guide_bound
+from ._costs import kernel_form, optimal_path, point_cost_matrix
 
 
 def path_indices(
@@ -75,8 +48,7 @@ def path_indices(
         return optimal_path(point_cost_matrix(x, y, manifold, squared), window)
     # the point costs are computed inside the accumulation (the T_x x T_y cost matrix is
     # never stored) and only where a path could still beat the guide's cost
-    fx = _kernels.kernel_points(manifold, _flat(x))
-    fy = _kernels.kernel_points(manifold, _flat(y))
+    fx, fy = kernel_form(x, manifold), kernel_form(y, manifold)
     bound = guide_bound(x, y, manifold, window, squared, guide)
     rows = _kernels.accumulated_segment_cost(fx, fy, segments, squared, window, bound)
     cost = _kernels.ragged_value(*rows, len(x) - 1, len(y) - 1)
@@ -88,29 +60,57 @@ def path_indices(
     return _kernels.ragged_backtrack(*rows, len(y)), float(cost)
 
 
-def medoid_index(
-    collection: SeriesCollection,
-    candidates: np.ndarray | None = None,
-    window: float | None = None,
+def has_compiled_costs(manifold: Manifold) -> bool:
+    """Whether the compiled kernels compute ``manifold``'s point costs themselves (then
+    :func:`mean_matched_positions` applies)."""
+    return _kernels.segment_codes(manifold) is not None
+
+
+def mean_matched_positions(
+    references: np.ndarray,
+    reference_lengths: np.ndarray,
+    series: np.ndarray,
+    lengths: np.ndarray,
+    codes: np.ndarray,
+    manifold: Manifold,
+    window: float = -1.0,
     squared: bool = True,
-) -> int:
-    """Index of the series with the smallest summed DTW cost to the others.
+) -> np.ndarray:
+    """For every series, the mean index of its samples matched with each sample of its
+    reference on their optimal DTW path, in one compiled pass (no path stored).
 
     Parameters
     ----------
-    collection : SeriesCollection
-    candidates : ndarray of int, optional
-        Only these series take part (both as candidates and as the others); default all.
-    window : float in [0, 1], optional
-        Sakoe–Chiba band.
+    references : ndarray of shape (G, L_max, *point_shape)
+        The references, each padded by repeating its last sample.
+    reference_lengths : ndarray of shape (G,), int
+    series : ndarray of shape (N, T_max, *point_shape)
+        The series, each padded by repeating its last sample.
+    lengths : ndarray of shape (N,), int
+    codes : ndarray of shape (N,), int
+        The reference of each series.
+    manifold : Manifold
+        One with compiled point costs (:func:`has_compiled_costs`).
+    window : float, default=-1
+        Sakoe–Chiba radius (fraction of the shorter series); negative: no band.
     squared : bool, default=True
         Squared geodesic point costs.
 
     Returns
     -------
-    index : int
-        Index into ``collection``.
+    positions : ndarray of shape (N, L_max)
+        Row ``n`` holds ``reference_lengths[codes[n]]`` values (the rest is zero); the
+        paths are those of :func:`path_indices` (ties broken alike).
     """
-    index = np.arange(collection.n_series) if candidates is None else np.asarray(candidates)
-    D = dtw_pairwise_distance(collection.subset(index), window=window, squared=squared)
-    return int(index[np.argmin(D.sum(1))])
+    segments = _kernels.segment_codes(manifold)
+    if segments is None:
+        raise ValueError(f"{manifold!r} has no compiled point costs")
+
+    def form(a: np.ndarray) -> np.ndarray:
+        flat = a.reshape(a.shape[0], a.shape[1], -1)
+        return np.ascontiguousarray(_kernels.kernel_points(manifold, flat))
+
+    return _kernels.matched_positions(
+        form(references), np.asarray(reference_lengths), form(series), np.asarray(lengths),
+        np.asarray(codes), segments, squared, window,
+    )  # fmt: skip

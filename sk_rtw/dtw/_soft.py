@@ -75,7 +75,26 @@ def soft_dtw(cost: np.ndarray, gamma: float, window: float):
 
 @njit(cache=True, nogil=True, parallel=True)
 def soft_dtw_batch(costs, nxs, nys, gamma, window):
-    """:func:`soft_dtw` for a stack of padded cost matrices ``(K, m_max, n_max)``."""
+    """Soft-DTW values and expected alignments of a stack of padded cost matrices.
+
+    Parameters
+    ----------
+    costs : ndarray of shape (K, m_max, n_max)
+        Point costs; matrix ``k`` is its top-left ``nxs[k] x nys[k]`` block.
+    nxs, nys : ndarray of shape (K,), int
+    gamma : float
+        Smoothing (> 0); small values approach the hard DTW.
+    window : float
+        Sakoe–Chiba radius as a fraction of the shorter series; negative: no band.
+
+    Returns
+    -------
+    values : ndarray of shape (K,)
+        The soft-minimum path costs.
+    E : ndarray of shape (K, m_max, n_max)
+        The expected alignment matrices (the gradients of the values with respect to
+        the costs), zero in the padding.
+    """
     k_total = costs.shape[0]
     values = np.empty(k_total)
     E = np.zeros_like(costs)
