@@ -366,8 +366,18 @@ def aligned_statistics(
     if isinstance(ddof, bool) or not isinstance(ddof, (int, np.integer)) or ddof < 0:
         raise ValueError(f"ddof must be a non-negative integer, got {ddof!r}")
     if n_series - ddof < 1:
+        single = (
+            "this alignment is a centroid of one training series (an estimator's "
+            "alignments_[k] of type SeriesCentroid: nothing was averaged; "
+            "centroid_classes_[k] names its class). Pass ddof=0 for its spread (zero), or "
+            "fit with fewer centroids per class (n_centroids=1, or a smaller fraction) so "
+            "that every centroid averages several series"
+            if alignment is not None and n_series == 1
+            else "align more series, or lower ddof"
+        )
         raise ValueError(
-            f"a covariance needs more than ddof={ddof} aligned series; got {n_series}"
+            f"a covariance needs more than ddof={ddof} aligned series; got {n_series}: "
+            + single
         )
     if not (isinstance(reg, (int, float, np.floating)) and np.isfinite(reg) and reg >= 0):
         raise ValueError(f"reg must be a finite number >= 0, got {reg!r}")

@@ -143,3 +143,15 @@ def test_bad_inputs_of_the_statistics():
         stats.mahalanobis(np.zeros((2, 4, 1)))
     with pytest.raises(ValueError, match="entries"):
         E.from_coordinates(np.zeros((2, 1)), torch.zeros(2, 3))
+
+
+def test_a_centroid_of_one_series_says_what_to_do():
+    from sk_rtw import RTWNearestCentroid
+
+    X = make_warped_signals("euclidean", 6, 30, random_state=0).signals
+    y = np.array([0, 0, 0, 0, 0, 1])  # class 1: one series, its own centroid
+    model = RTWNearestCentroid(n_centroids=1, dtw_window=None, method="dba").fit(X, y)
+    single = model.alignments_[int(np.flatnonzero(model.centroid_classes_ == 1)[0])]
+    with pytest.raises(ValueError, match="centroid of one training series.*ddof=0"):
+        aligned_statistics(single)
+    assert np.all(aligned_statistics(single, ddof=0, reg=0.0).covariance == 0.0)

@@ -198,9 +198,10 @@ KNOBS: dict[str, Knob] = {
         Knob(
             "refine_steps",
             _integer(0),
-            "Steps, at each of two soft-DTW temperatures, of the final refinement of the mean "
-            "as free points on the manifold towards a lower DTW cost to the series (0: none; "
-            "see sk_rtw.align._refine).",
+            "Steps, at each of two soft-DTW temperatures, of a final refinement of the mean as "
+            "free points on the manifold: each step is the weighted Fréchet mean under the "
+            "soft-DTW expected alignments to the series, and the mean of lowest DTW cost is "
+            "kept (0: none).",
             _every(0),
         ),
         Knob("max_iter", _integer(1), "Most DBA refinement iterations.", {"dba": 10}),

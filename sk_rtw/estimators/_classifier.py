@@ -97,10 +97,8 @@ class RTWNearestCentroid(ClassifierMixin, RTWAverager):
     exact protocol; ``method="dba"`` for the fastest fit; ``n_centroids=1.0`` for 1-NN
     DTW within the band. Splitting a class into centroids needs the DTW matrix of its
     series, which without a band grows with the square of the class size and of the
-    length: on 1,000 series of 2,709 samples the default took 92 minutes and 8 per class
-    without a band 87, against 4 for one mean per class and 8 for ``n_centroids=8,
-    dtw_window=0.05``. Where classes hold hundreds of long series, fix the band or take
-    one mean per class. The method's own settings go in its object:
+    length (the classification guide gives measured times): where classes hold hundreds
+    of long series, fix the band or take one mean per class. The method's own settings go in its object:
     ``method=RTW(n_epochs=64)``, searchable as ``method__n_epochs``.
 
     Parameters
