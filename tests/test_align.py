@@ -694,7 +694,7 @@ def _groups_data():
 @pytest.mark.parametrize("method", ["rtw", "ttw", "ntw"])
 def test_groups_in_one_batch_equal_separate_fits(method):
     from sk_rtw.align._config import resolve_config
-    from sk_rtw.align._engine import align_collection
+    from sk_rtw.align._fit import align_collection
     from sk_rtw.utils import check_series_collection
 
     series, codes = _groups_data()
@@ -721,8 +721,9 @@ def test_groups_in_one_batch_equal_separate_fits(method):
 def test_narrowing_the_batch_to_the_running_groups_changes_no_result(method, preset, monkeypatch):
     """Groups that stop early leave the batch (the engine narrows it once half have
     stopped): every group's result is that of the whole batch run to the end."""
-    from sk_rtw.align import _engine
+    from sk_rtw.align import _narrowing, _problem
     from sk_rtw.align._config import resolve_config
+    from sk_rtw.align._fit import align_collection
     from sk_rtw.utils import check_series_collection
 
     series, codes = [], []
@@ -735,12 +736,12 @@ def test_narrowing_the_batch_to_the_running_groups_changes_no_result(method, pre
                                              "n_iter_no_change": 3, "tol": 1e-2})  # fmt: skip
     seeds = [3, 1, 4, 1, 5]
     subsets = []
-    original = _engine._Problem.subset
-    monkeypatch.setattr(_engine._Problem, "subset",
+    original = _problem.Problem.subset
+    monkeypatch.setattr(_problem.Problem, "subset",
                         lambda self, groups: subsets.append(len(groups)) or original(self, groups))
-    narrowed = _engine.align_collection(collection, codes, seeds, config)
-    monkeypatch.setattr(_engine, "_half_stopped", lambda active: False)
-    whole = _engine.align_collection(collection, codes, seeds, config)
+    narrowed = align_collection(collection, codes, seeds, config)
+    monkeypatch.setattr(_narrowing, "half_stopped", lambda active: False)
+    whole = align_collection(collection, codes, seeds, config)
     assert subsets, "the batch was never narrowed"
     assert len({r.n_iter for r in whole}) > 1  # the groups stopped at different epochs
     for a, b in zip(narrowed, whole, strict=True):

@@ -152,6 +152,6 @@ def test_a_centroid_of_one_series_says_what_to_do():
     y = np.array([0, 0, 0, 0, 0, 1])  # class 1: one series, its own centroid
     model = RTWNearestCentroid(n_centroids=1, dtw_window=None, method="dba").fit(X, y)
     single = model.alignments_[int(np.flatnonzero(model.centroid_classes_ == 1)[0])]
-    with pytest.raises(ValueError, match="centroid of one training series.*ddof=0"):
+    with pytest.raises(ValueError, match=r"centroid of one training series.*ddof=0"):
         aligned_statistics(single)
     assert np.all(aligned_statistics(single, ddof=0, reg=0.0).covariance == 0.0)

@@ -98,8 +98,8 @@ class RTWNearestCentroid(ClassifierMixin, RTWAverager):
     DTW within the band. Splitting a class into centroids needs the DTW matrix of its
     series, which without a band grows with the square of the class size and of the
     length (the classification guide gives measured times): where classes hold hundreds
-    of long series, fix the band or take one mean per class. The method's own settings go in its object:
-    ``method=RTW(n_epochs=64)``, searchable as ``method__n_epochs``.
+    of long series, fix the band or take one mean per class. The method's own settings
+    go in its object: ``method=RTW(n_epochs=64)``, searchable as ``method__n_epochs``.
 
     Parameters
     ----------

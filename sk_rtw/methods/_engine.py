@@ -8,7 +8,8 @@ from typing import Any
 import numpy as np
 
 from ..align._config import AlignmentConfig, resolve_config, size_config
-from ..align._engine import Alignment, align_collection
+from ..align._fit import align_collection
+from ..align._result import Alignment
 from ..utils import SeriesCollection
 from ..utils._params import drop_auto
 from ._base import AveragingMethod, FitContext, method_class
