@@ -448,7 +448,7 @@ def test_trainer_keeps_the_lowest_loss_parameters():
     # a loss with its minimum at 1; a large rate makes Adam overshoot and come back
     trainer = Trainer(lambda: (weight - 1.0).abs().sum(), [weight], 30, 1.5)
     (best,) = trainer.run(lambda done, history: None, 10)
-    history = trainer.history[:, 0].numpy()
+    history = trainer.progress.history[:, 0].numpy()
     assert best == int(np.argmin(history))
     assert abs(float(weight.detach()) - 1.0) == pytest.approx(history[best])
 
@@ -477,11 +477,11 @@ def test_trainer_stops_each_group_on_its_own_and_keeps_its_best():
 
     both, best, weight = run(torch.tensor([0, 1]), 2)
     alone, best_alone, weight_alone = run(torch.tensor([0]), 1)
-    runs = both.epochs_run.numpy()
+    runs = both.progress.epochs_run.numpy()
     assert runs[0] < runs[1] == 200  # group 0 stopped early, group 1 ran to the end
-    assert runs[0] == alone.epochs_run.numpy()[0] and best[0] == best_alone[0]
+    assert runs[0] == alone.progress.epochs_run.numpy()[0] and best[0] == best_alone[0]
     torch.testing.assert_close(weight[0], weight_alone[0])
-    assert np.isnan(both.history[runs[0] :, 0].numpy()).all()
+    assert np.isnan(both.progress.history[runs[0] :, 0].numpy()).all()
 
 
 def test_a_narrowed_trainer_goes_on_as_the_whole_one_would():
@@ -506,20 +506,22 @@ def test_a_narrowed_trainer_goes_on_as_the_whole_one_would():
     trainer = make(weight, torch.arange(3))
     assert trainer.run(lambda done, history: None, 50, pause=lambda a: not bool(a.all())) is None
     paused_at = trainer.epochs_done
-    keep = torch.nonzero(trainer.active).flatten()
-    stopped = torch.nonzero(~trainer.active).flatten()
+    keep = torch.nonzero(trainer.progress.active).flatten()
+    stopped = torch.nonzero(~trainer.progress.active).flatten()
     assert 0 < paused_at < 150 and 0 < len(keep) < 3
     frozen = trainer.best[0][stopped].clone()
     part = torch.nn.Parameter(weight.detach()[keep].clone())
     narrowed = trainer.narrow(keep, make(part, keep).loss_fn, [part], [torch.arange(len(keep))])
     narrowed.run(lambda done, history: None, 50)
     assert narrowed.epochs_done > paused_at
-    np.testing.assert_array_equal(narrowed.epochs_run.numpy(), whole.epochs_run[keep].numpy())
-    np.testing.assert_array_equal(narrowed.best_epoch.numpy(), whole.best_epoch[keep].numpy())
-    np.testing.assert_array_equal(narrowed.history.numpy(), whole.history[:, keep].numpy())
+    for name in ("epochs_run", "best_epoch"):
+        np.testing.assert_array_equal(getattr(narrowed.progress, name).numpy(),
+                                      getattr(whole.progress, name)[keep].numpy())  # fmt: skip
+    np.testing.assert_array_equal(narrowed.progress.history.numpy(),
+                                  whole.progress.history[:, keep].numpy())  # fmt: skip
     np.testing.assert_array_equal(part.detach().numpy(), whole_weight.detach()[keep].numpy())
     np.testing.assert_array_equal(frozen.numpy(), whole_weight.detach()[stopped].numpy())
-    np.testing.assert_array_equal(narrowed.group_ids, keep.numpy())
+    np.testing.assert_array_equal(narrowed.progress.ids, keep.numpy())
 
 
 def test_early_stopping_saves_epochs_and_keeps_the_best():

@@ -98,9 +98,9 @@ class BatchOptimisation:
         trainer = self.trainer
         best = trainer.run(report, every, pause=half_stopped if self.narrowing else None)
         ids = self.running.numpy()
-        self.losses[:, ids] = trainer.history.cpu().numpy()
-        self.best_epoch[ids] = trainer.best_epoch.cpu().numpy()
-        self.epochs_run[ids] = trainer.epochs_run.cpu().numpy()
+        self.losses[:, ids] = trainer.progress.history.cpu().numpy()
+        self.best_epoch[ids] = trainer.progress.best_epoch.cpu().numpy()
+        self.epochs_run[ids] = trainer.progress.epochs_run.cpu().numpy()
         if best is None:
             return False
         if self.stage_model is not self.model:
@@ -111,9 +111,9 @@ class BatchOptimisation:
         """The stopped groups' best iterates back to the whole model; the problem, the
         model and the trainer of the running groups only."""
         trainer = self.trainer
-        stopped = torch.nonzero(~trainer.active.cpu()).flatten()
+        stopped = torch.nonzero(~trainer.progress.active.cpu()).flatten()
         self._write_back(self.running[stopped], trainer.best, trainer.rows(stopped))
-        keep = torch.nonzero(trainer.active.cpu()).flatten()
+        keep = torch.nonzero(trainer.progress.active.cpu()).flatten()
         problem = self.stage_problem.subset(keep.to(self.stage_problem.layout.codes.device))
         model = self.stage_model.subset(keep.to(trainer.device))
         loss = partial(stage_loss, problem, model)

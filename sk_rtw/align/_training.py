@@ -37,6 +37,7 @@ import math
 import sys
 import warnings
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 
 import numpy as np
 import torch
@@ -53,6 +54,49 @@ def _group_shapes(parameter_groups, parameters, device) -> list[torch.Tensor]:
         groups.to(device).view(-1, *([1] * max(p.ndim - 1, 0)))
         for groups, p in zip(parameter_groups, parameters, strict=True)
     ]
+
+
+@dataclass
+class GroupProgress:
+    """Every group's progress, one entry per group (``history``: one column per group),
+    updated in place by every epoch (a CUDA graph replays those updates)."""
+
+    #: The lowest loss so far, and its epoch (-1: none yet).
+    best_loss: torch.Tensor
+    best_epoch: torch.Tensor
+    #: Still training; epochs in a row without a significant improvement.
+    active: torch.Tensor
+    stalled: torch.Tensor
+    #: Epochs trained, and the loss of each (NaN once the group stopped).
+    epochs_run: torch.Tensor
+    history: torch.Tensor
+    #: The caller's number of every group (a narrowed trainer's error messages name it).
+    ids: np.ndarray
+
+    @classmethod
+    def start(cls, n_groups: int, n_epochs: int, dtype, device) -> GroupProgress:
+        shape = (max(1, n_epochs), n_groups)
+        return cls(
+            best_loss=torch.full((n_groups,), math.inf, dtype=dtype, device=device),
+            best_epoch=torch.full((n_groups,), -1, dtype=torch.long, device=device),
+            active=torch.ones(n_groups, dtype=torch.bool, device=device),
+            stalled=torch.zeros(n_groups, dtype=torch.long, device=device),
+            epochs_run=torch.zeros(n_groups, dtype=torch.long, device=device),
+            history=torch.full(shape, math.nan, dtype=dtype, device=device),
+            ids=np.arange(n_groups),
+        )
+
+    def select(self, groups: torch.Tensor) -> GroupProgress:
+        """The progress of ``groups`` (indices), copied."""
+        return GroupProgress(
+            best_loss=self.best_loss[groups].clone(),
+            best_epoch=self.best_epoch[groups].clone(),
+            active=self.active[groups].clone(),
+            stalled=self.stalled[groups].clone(),
+            epochs_run=self.epochs_run[groups].clone(),
+            history=self.history[:, groups].clone(),
+            ids=self.ids[groups.cpu().numpy()],
+        )
 
 
 class Trainer:
@@ -110,20 +154,10 @@ class Trainer:
             parameter_groups = [torch.zeros(p.shape[0] if p.ndim else 1, dtype=torch.long)
                                 for p in parameters]  # fmt: skip
         self._shapes = _group_shapes(parameter_groups, parameters, device)
-        #: Which group each of this trainer's groups is in the caller's numbering (error
-        #: messages of a narrowed trainer name the caller's groups).
-        self.group_ids = np.arange(n_groups)
         self.whole_groups = n_groups
         self.epochs_done = 0
         self.best = [p.detach().clone() for p in parameters]
-        self.best_loss = torch.full((n_groups,), math.inf, dtype=dtype, device=device)
-        self.best_epoch = torch.full((n_groups,), -1, dtype=torch.long, device=device)
-        self.active = torch.ones(n_groups, dtype=torch.bool, device=device)
-        self.stalled = torch.zeros(n_groups, dtype=torch.long, device=device)
-        self.epochs_run = torch.zeros(n_groups, dtype=torch.long, device=device)
-        self.history = torch.full(
-            (max(1, n_epochs), n_groups), math.nan, dtype=dtype, device=device
-        )
+        self.progress = GroupProgress.start(n_groups, n_epochs, dtype, device)
         self.epoch = torch.zeros(1, dtype=torch.long, device=device)
         self._limit = n_iter_no_change if n_iter_no_change is not None else max(1, n_epochs) + 1
 
@@ -141,12 +175,13 @@ class Trainer:
         total.backward()
         with torch.no_grad():
             value = groups.detach()
-            active = self.active
-            better = (value < self.best_loss) & active  # False for NaN
-            threshold = self.best_loss - self.tol * self.best_loss.abs()
-            significant = (value < threshold) | torch.isinf(self.best_loss)
-            self.best_loss.copy_(torch.where(better, value, self.best_loss))
-            self.best_epoch.copy_(torch.where(better, self.epoch, self.best_epoch))
+            progress = self.progress
+            active, best_loss = progress.active, progress.best_loss
+            better = (value < best_loss) & active  # False for NaN
+            threshold = best_loss - self.tol * best_loss.abs()
+            significant = (value < threshold) | torch.isinf(best_loss)
+            best_loss.copy_(torch.where(better, value, best_loss))
+            progress.best_epoch.copy_(torch.where(better, self.epoch, progress.best_epoch))
             # on a CPU reading the flags is free: copy only when a group improved, and
             # plainly when every group did (one group: each improving epoch)
             if self.cuda or bool(better.any()):
@@ -154,12 +189,12 @@ class Trainer:
                 for kept, current, shape in zip(self.best, self.parameters, self._shapes,
                                                 strict=True):  # fmt: skip
                     kept.copy_(current if every else torch.where(better[shape], current, kept))
-            self.history.index_copy_(
+            progress.history.index_copy_(
                 0, self.epoch, torch.where(active, value, math.nan).unsqueeze(0)
             )
-            self.epochs_run.add_(active.long())
-            self.stalled.copy_(torch.where(significant, 0, self.stalled + 1))
-            self.active.copy_(active & (self.stalled < self._limit))
+            progress.epochs_run.add_(active.long())
+            progress.stalled.copy_(torch.where(significant, 0, progress.stalled + 1))
+            active.copy_(active & (progress.stalled < self._limit))
             self.epoch += 1
         self.optimiser.step()
 
@@ -192,7 +227,8 @@ class Trainer:
             graph = self._capture() if done < self.n_epochs else None
         # on a CPU reading the flags costs nothing: check every epoch
         check_every = report_every if self.cuda else 1
-        while done < self.n_epochs and bool(self.active.any()):
+        active = self.progress.active
+        while done < self.n_epochs and bool(active.any()):
             block = min(check_every, self.n_epochs - done)
             for _ in range(block):
                 if graph is not None:
@@ -200,17 +236,17 @@ class Trainer:
                 else:
                     self.step()
             done += block
-            stopped = not bool(self.active.any())
+            stopped = not bool(active.any())
             announce = done % report_every == 0 or done == self.n_epochs or stopped
             self._check(done, report if announce else None)
             self.epochs_done = done
-            if pause is not None and not stopped and done < self.n_epochs and pause(self.active):
+            if pause is not None and not stopped and done < self.n_epochs and pause(active):
                 return None
         self.epochs_done = done
         with torch.no_grad():
             for current, kept in zip(self.parameters, self.best, strict=True):
                 current.copy_(kept)
-        return self.best_epoch.cpu().numpy()
+        return self.progress.best_epoch.cpu().numpy()
 
     def rows(self, groups: torch.Tensor) -> list[torch.Tensor]:
         """For every parameter, the indices of its leading axis that belong to ``groups``."""
@@ -234,13 +270,10 @@ class Trainer:
         other.loss_fn = loss_fn
         other.parameters = list(parameters)
         other.n_groups = len(groups)
-        other.group_ids = self.group_ids[groups.cpu().numpy()]
         other._shapes = _group_shapes(parameter_groups, other.parameters, self.device)
         other.optimiser = self.optimiser.narrow(other.parameters, rows)
         other.best = [kept[r].clone() for kept, r in zip(self.best, rows, strict=True)]
-        for name in ("best_loss", "best_epoch", "active", "stalled", "epochs_run"):
-            setattr(other, name, getattr(self, name)[groups].clone())
-        other.history = self.history[:, groups].clone()
+        other.progress = self.progress.select(groups)
         other.epoch = self.epoch.clone()
         return other
 
@@ -278,13 +311,13 @@ class Trainer:
     # ---------------------------------------------------------------- checks
     def _check(self, done: int, report) -> None:
         """Raise on a non-finite loss among the first ``done``; then ``report`` if given."""
-        history = self.history[:done].cpu().numpy()
-        epochs_run = self.epochs_run.cpu().numpy()
+        history = self.progress.history[:done].cpu().numpy()
+        epochs_run = self.progress.epochs_run.cpu().numpy()
         for g in range(self.n_groups):
             values = history[: epochs_run[g], g]
             bad = np.flatnonzero(~np.isfinite(values))
             if bad.size:
-                where = f" of group {self.group_ids[g]}" if self.whole_groups > 1 else ""
+                where = f" of group {self.progress.ids[g]}" if self.whole_groups > 1 else ""
                 raise FloatingPointError(
                     f"the alignment loss{where} became {values[bad[0]]} at epoch {bad[0]}; "
                     "lower learning_rate or check the data scale"
