@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -890,6 +891,16 @@ def test_the_engines_adam_is_torchs_fused_adam_bit_for_bit():
         for a, b in zip(ours, theirs, strict=True):
             assert torch.equal(a, b), step
     assert not torch.equal(ours[0], start[0])  # it moved
+
+
+def test_the_torch_floor_is_read_from_the_version():
+    from sk_rtw.align._adam import MIN_TORCH, _release
+
+    assert _release("2.13.0+cpu") == (2, 13) and _release("2.4.0a0+git1234") == (2, 4)
+    assert _release("2.3.1+cu121") < MIN_TORCH <= _release("2.4.1") <= _release(torch.__version__)
+    # the floor is the one pyproject.toml declares
+    pyproject = (Path(__file__).parents[1] / "pyproject.toml").read_text()
+    assert f'"torch>={MIN_TORCH[0]}.{MIN_TORCH[1]}"' in pyproject
 
 
 @pytest.mark.parametrize("manifold", ["euclidean", "quaternion", "spd"])

@@ -7,6 +7,10 @@ samples) and again in every worker of a parallel grid search. :class:`FusedAdam`
 the same kernel with the same state (first and second moments, a float32 step counter on
 the parameters' device), so the updates are bit for bit those of ``torch.optim.Adam``
 (tested), at no import cost.
+
+The kernel runs on the CPU from torch 2.4 on (CUDA since 2.0), the floor that
+``pyproject.toml`` declares; an older torch is refused at import with that message
+rather than with the dispatcher's error at the first epoch.
 """
 
 from __future__ import annotations
@@ -14,6 +18,22 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import torch
+
+#: The oldest torch whose fused Adam kernel has a CPU implementation.
+MIN_TORCH = (2, 4)
+
+
+def _release(version: str) -> tuple[int, int]:
+    """``(major, minor)`` of a torch version string (``"2.13.0+cpu"`` -> ``(2, 13)``)."""
+    major, minor = version.split("+")[0].split(".")[:2]
+    return int(major), int("".join(c for c in minor if c.isdigit()) or 0)
+
+
+if _release(torch.__version__) < MIN_TORCH:
+    raise ImportError(
+        f"sk_rtw needs torch>={MIN_TORCH[0]}.{MIN_TORCH[1]} (its fused Adam kernel on the "
+        f"CPU); this is torch {torch.__version__}: pip install 'torch>=2.4'"
+    )
 
 
 class FusedAdam:
