@@ -197,7 +197,7 @@ def test_bad_arguments_are_named():
         dtw_nearest_distance(X, X, exclude_group=[0.5, 0, 0])
     with pytest.raises(ValueError, match="max_distance must not be NaN"):
         dtw_nearest_distance(X, X, max_distance=np.nan)
-    with pytest.raises(ValueError, match="window must lie in"):
+    with pytest.raises(ValueError, match="window must be a finite number in \\[0, 1\\] or None"):
         dtw_nearest_distance(X, X, window=2.0)
     with pytest.raises(ValueError, match="NaN"):
         dtw_nearest_distance(np.full((2, 5), np.nan), X)

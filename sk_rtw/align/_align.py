@@ -3,6 +3,7 @@ its documentation rendered from the declarations, one batch of one group."""
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -45,10 +46,9 @@ ALIGN_VERBOSE = Parameter(
     "Print the loss every max(1, n_epochs // 10) epochs (True or 1), or every verbose "
     "epochs (an int > 1).",
 )
-ALIGN_WINDOW = Parameter(
-    "dtw_window",
-    DTW_WINDOW.constraints,
-    "Sakoe-Chiba band of the DTW start (its medoid and paths), its radius as a fraction "
+ALIGN_WINDOW = replace(
+    DTW_WINDOW,
+    doc="Sakoe-Chiba band of the DTW start (its medoid and paths), its radius as a fraction "
     "of the shorter series' length; None: no band.",
 )
 ALIGN_METHOD = Parameter(

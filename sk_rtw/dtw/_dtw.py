@@ -15,6 +15,7 @@ import numpy as np
 from .._numba import numba_threads
 from ..manifolds import Manifold
 from ..utils import SeriesCollection, check_series, check_series_collection
+from ..utils._common_params import DTW_WINDOW
 from . import _kernels
 from ._band import EXACT_CELLS, guide_bound
 from ._costs import check_costs, kernel_form, point_cost_matrix
@@ -24,7 +25,8 @@ _NORMALIZE = (None, "path")
 
 
 def check_window(window: float | None, name: str = "window") -> float:
-    """Check a Sakoe–Chiba radius and return it in the kernels' convention.
+    """Check a Sakoe–Chiba radius (the package's one ``dtw_window`` declaration) and
+    return it in the kernels' convention.
 
     Parameters
     ----------
@@ -38,16 +40,8 @@ def check_window(window: float | None, name: str = "window") -> float:
     radius : float
         ``window`` as a float, or -1.0 for no band.
     """
-    if window is None:
-        return -1.0
-    if isinstance(window, bool) or not isinstance(window, (int, float, np.integer, np.floating)):
-        raise TypeError(f"{name} must be a float in [0, 1] or None, got {window!r}")
-    if not 0.0 <= float(window) <= 1.0:
-        raise ValueError(
-            f"{name} must lie in [0, 1] (Sakoe–Chiba radius as a fraction of the shorter "
-            f"series), got {window}"
-        )
-    return float(window)
+    value = DTW_WINDOW.check(window, name)
+    return -1.0 if value is None else float(value)
 
 
 def _check_normalize(normalize: str | None) -> None:

@@ -185,7 +185,7 @@ class RTWAverager(TransformerMixin, BaseEstimator):
             preset=params["preset"], device=params["device"], n_jobs=params["n_jobs"],
             verbose=int(params["verbose"]),
         )  # fmt: skip
-        config = method.configure(context)  # every setting checked and resolved, once
+        method.check_settings()  # every setting checked before any work
         collection = check_series_collection(X, self.manifold)
         if y is None:
             labels = np.zeros(collection.n_series, dtype=int)
@@ -209,6 +209,7 @@ class RTWAverager(TransformerMixin, BaseEstimator):
                 window = None if window == "auto" else window
                 n_centroids = 1 if n_centroids == "auto" else n_centroids
         context = replace(context, dtw_window=window)
+        config = method.configure(context)  # resolved once, with the band chosen
         owner = type(self).__name__
         if isinstance(n_centroids, int) and n_centroids == 1:
             groups, owners = codes, np.arange(len(classes))

@@ -7,6 +7,8 @@ of a method (the engine's knobs, DBA's iterations) lives in the method object
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 from ..align._config import DEVICE_PARAMETER, PRESET_PARAMETER, settings_table
 from ..align._knobs import owners
 from ..methods._registry import METHODS, method_parameter
@@ -33,10 +35,9 @@ N_CENTROIDS = Parameter(
     'scores in ``selection_``) under "class-means" and "alignment", one mean per class '
     'under "paper".',
 )
-DTW_WINDOW = Parameter(
-    "dtw_window",
-    (*BAND.constraints, Options(("auto",))),
-    "Sakoe-Chiba band of every DTW of the fit (the DTW start of RTW, TTW and NTW, DBA, "
+DTW_WINDOW = replace(
+    BAND.with_auto(),
+    doc="Sakoe-Chiba band of every DTW of the fit (the DTW start of RTW, TTW and NTW, DBA, "
     "the partition into centroids) and of prediction, its radius as a fraction of the "
     'shorter series\' length; None: no band. "auto": the preset\'s value: chosen from the '
     'training data with the centroids (fitted ``dtw_window_``) under "class-means" and '

@@ -62,8 +62,8 @@ class FitContext:
         Name of the preset whose values ``"auto"`` settings take.
     dtw_window : float or None
         Sakoe–Chiba band of the method's DTW (DBA, the DTW start), as a fraction of the
-        series length; applied in :meth:`AveragingMethod.fit_groups` (an estimator may
-        choose it from the data after :meth:`AveragingMethod.configure`).
+        series length; an estimator that chooses it from the data configures the method
+        with the chosen band (the shipped methods resolve it into their configuration).
     device : str
         Torch device of the engine's optimisation.
     n_jobs : int or None
@@ -124,6 +124,21 @@ class AveragingMethod(BaseEstimator):
 
     def __hash__(self) -> int:
         return hash((type(self), tuple(sorted(map(repr, self.get_params().items())))))
+
+    def check_settings(self) -> None:
+        """Check every setting, before a fit does any work (an estimator resolves them
+        with :meth:`configure` once it knows the band it uses).
+
+        The default checks the parameters against the class's declaration, when it has
+        one; a method of your own may check more here, or leave it to :meth:`configure`.
+
+        Raises
+        ------
+        InvalidParameterError
+            Naming the setting and what it accepts.
+        """
+        if getattr(type(self), "_declaration", None) is not None:
+            validate_parameters(self)
 
     def configure(self, context: FitContext) -> Any:
         """Check every setting and resolve it, once per fit: the configuration that

@@ -59,8 +59,8 @@ class DBA(AveragingMethod):
         self.max_iter = max_iter
 
     def configure(self, context: FitContext) -> DBAConfig:
-        """Every setting checked and resolved (preset, then method, then the values given);
-        the estimator's band is applied by :meth:`fit_groups`.
+        """Every setting checked and resolved (preset, then method, then the values given),
+        the band the estimator's (``context``).
 
         Parameters
         ----------
@@ -72,7 +72,8 @@ class DBA(AveragingMethod):
         """
         given = drop_auto(super().configure(context))
         values = resolve_knobs(self.name, context.preset, given)
-        return DBAConfig(self.name, context.preset, values["max_iter"], values["tol"], None)
+        return DBAConfig(self.name, context.preset, values["max_iter"], values["tol"],
+                         context.dtw_window)  # fmt: skip
 
     def keeps_single_series(self, config: DBAConfig) -> bool:
         """True: the average starts at the group's medoid, the series, and stays there."""
@@ -87,7 +88,6 @@ class DBA(AveragingMethod):
         context: FitContext,
         starts: list[np.ndarray] | None = None,
     ) -> list[Any]:
-        config = dataclasses.replace(config, window=context.dtw_window)
         codes = np.asarray(codes, dtype=np.int64)
         members = [np.flatnonzero(codes == g) for g in range(int(codes.max()) + 1)]
         inits = ["medoid"] * len(members) if starts is None else list(starts)

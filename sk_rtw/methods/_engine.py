@@ -22,7 +22,7 @@ class EngineMethod(AveragingMethod):
     def configure(self, context: FitContext) -> AlignmentConfig:
         """Every setting checked and resolved (preset, then method, then the values given):
         the engine's configuration, its output length left to the preset's rule
-        (``None``) unless given; the estimator's band is applied by :meth:`fit_groups`.
+        (``None``) unless given, the DTW start's band the estimator's (``context``).
 
         Parameters
         ----------
@@ -33,7 +33,8 @@ class EngineMethod(AveragingMethod):
         AlignmentConfig
         """
         given = drop_auto(super().configure(context))
-        return resolve_config(self.name, context.preset, given, device=context.device)
+        return resolve_config(self.name, context.preset, given, device=context.device,
+                              dtw_window=context.dtw_window)  # fmt: skip
 
     def fit_groups(
         self,
@@ -44,7 +45,6 @@ class EngineMethod(AveragingMethod):
         context: FitContext,
         starts: list[np.ndarray] | None = None,
     ) -> list[Any]:
-        config = dataclasses.replace(config, dtw_window=context.dtw_window)
         codes = np.asarray(codes, dtype=np.int64)
         n_groups = int(codes.max()) + 1
         lengths = collection.lengths
