@@ -696,8 +696,7 @@ def _groups_data():
 
 @pytest.mark.parametrize("method", ["rtw", "ttw", "ntw"])
 def test_groups_in_one_batch_equal_separate_fits(method):
-    from sk_rtw.align._config import resolve_config
-    from sk_rtw.align._fit import align_collection
+    from sk_rtw.align import align_collection, resolve_config
     from sk_rtw.utils import check_series_collection
 
     series, codes = _groups_data()
@@ -724,9 +723,7 @@ def test_groups_in_one_batch_equal_separate_fits(method):
 def test_narrowing_the_batch_to_the_running_groups_changes_no_result(method, preset, monkeypatch):
     """Groups that stop early leave the batch (the engine narrows it once half have
     stopped): every group's result is that of the whole batch run to the end."""
-    from sk_rtw.align import _narrowing, _problem
-    from sk_rtw.align._config import resolve_config
-    from sk_rtw.align._fit import align_collection
+    from sk_rtw.align import _narrowing, _problem, align_collection, resolve_config
     from sk_rtw.utils import check_series_collection
 
     series, codes = [], []

@@ -744,7 +744,7 @@ def test_every_field_of_a_refined_result_describes_the_refined_mean():
 
 
 def test_help_of_align_states_the_default_output_length():
-    from sk_rtw.align._presets import PRESETS
+    from sk_rtw.align import PRESETS
 
     text = " ".join(align.__doc__.split())
     for name in ("alignment", "paper"):

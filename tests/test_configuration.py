@@ -14,8 +14,8 @@ from sklearn.model_selection import GridSearchCV
 
 import sk_rtw
 from sk_rtw import RTW, RTWAverager, RTWKMeans, RTWNearestCentroid
+from sk_rtw._settings._resolve import _cell
 from sk_rtw.align import KNOBS, PRESETS
-from sk_rtw.align._config import _cell
 from sk_rtw.baselines import dba_average
 from sk_rtw.methods import METHODS, AveragingMethod, EngineMethod
 from sk_rtw.utils._params import Interval, Parameter, declare_parameters

@@ -20,14 +20,8 @@ import pytest
 from sklearn.base import clone
 
 from sk_rtw import RTW, RTWAverager, RTWKMeans, RTWNearestCentroid, align
-from sk_rtw.align import ENGINE_METHODS, KNOBS, PRESETS
-from sk_rtw.align._config import (
-    knobs_markdown,
-    presets_markdown,
-    resolve_config,
-    resolve_knobs,
-    size_config,
-)
+from sk_rtw._settings import knobs_markdown, presets_markdown, resolve_knobs
+from sk_rtw.align import ENGINE_METHODS, KNOBS, PRESETS, resolve_config, size_config
 from sk_rtw.datasets import make_warped_signals
 from sk_rtw.methods import METHODS, RESULT_FIELDS, AveragingResult, FitContext, get_method
 from sk_rtw.utils import check_series_collection

@@ -114,3 +114,27 @@ def test_only_the_dtw_package_opens_its_private_modules():
         if target.startswith("sk_rtw.dtw._") and not module.startswith("sk_rtw.dtw")
     )
     assert reaching_in == []
+
+
+def _package(module: str) -> str:
+    """The subpackage (or top-level module) of ``sk_rtw`` a module belongs to."""
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else parts[0]
+
+
+def test_packages_stand_on_floors():
+    """No circle of subpackages: a lower one (manifolds, utils, the settings, dtw, align)
+    never imports a higher one (methods, estimators)."""
+    packages: dict[str, set[str]] = {}
+    for module, targets in GRAPH.items():
+        if module == "sk_rtw":  # the top-level door imports everything
+            continue
+        packages.setdefault(_package(module), set()).update(
+            _package(t) for t in targets if _package(t) not in (_package(module), "sk_rtw")
+        )
+    for package in list(packages.values()):
+        for target in package:
+            packages.setdefault(target, set())
+    assert _circles(packages) == []
+    assert "align" not in packages["dtw"] and "methods" not in packages["align"]
+    assert "estimators" not in packages["methods"] and "align" not in packages["_settings"]

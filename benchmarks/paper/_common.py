@@ -73,7 +73,7 @@ def paper_parser(
 def parse_paper_args(parser: argparse.ArgumentParser, argv=None) -> argparse.Namespace:
     """Parse, then check what argparse cannot (settings, device, the output file) before
     any work."""
-    from sk_rtw.align._config import check_device
+    from sk_rtw._settings import check_device
 
     args = parser.parse_args(argv)
     if hasattr(args, "options"):
@@ -101,8 +101,8 @@ def add_engine_options(parser: argparse.ArgumentParser) -> None:
 
 def apply_engine_options(args: argparse.Namespace) -> None:
     """Check ``--options`` against the knob table (names and values) before any work."""
+    from sk_rtw._settings import knob_parameter
     from sk_rtw.align import KNOBS
-    from sk_rtw.align._config import knob_parameter
 
     if not isinstance(args.options, dict):
         raise SystemExit(f"error: --options must be a JSON object, got {args.options!r}")

@@ -88,8 +88,8 @@ from benchmarks.ucr._summary import (
     scatter_plot,
     verdict,
 )
+from sk_rtw._settings import check_device
 from sk_rtw.align import PRESETS
-from sk_rtw.align._config import check_device
 
 
 def parse_args(argv=None) -> argparse.Namespace:

@@ -1,9 +1,18 @@
 """The alignment engine: Riemannian Time Warping and its TTW/NTW baselines."""
 
+from .._settings import (
+    ENGINE_METHODS,
+    KNOBS,
+    PRESETS,
+    Knob,
+    OutputLength,
+    Preset,
+    knobs_markdown,
+    presets_markdown,
+)
 from ._align import align
-from ._config import AlignmentConfig, knobs_markdown, presets_markdown
-from ._knobs import ENGINE_METHODS, KNOBS, Knob
-from ._presets import PRESETS, OutputLength, Preset
+from ._config import AlignmentConfig, resolve_config, size_config
+from ._fit import align_collection
 from ._result import Alignment
 from ._sinc import tangent_sinc_interpolate
 
@@ -17,7 +26,10 @@ __all__ = [
     "OutputLength",
     "Preset",
     "align",
+    "align_collection",
     "knobs_markdown",
     "presets_markdown",
+    "resolve_config",
+    "size_config",
     "tangent_sinc_interpolate",
 ]

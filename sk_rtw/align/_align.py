@@ -10,6 +10,14 @@ import numpy as np
 import torch
 
 from .._random import check_generator
+from .._settings import (
+    DEVICE_PARAMETER,
+    ENGINE_METHODS,
+    KNOBS,
+    PRESET_PARAMETER,
+    check_knobs,
+    check_preset,
+)
 from ..manifolds import Manifold
 from ..utils import SeriesCollection, check_series_collection
 from ..utils._common_params import DTW_WINDOW, MANIFOLD, N_JOBS, RANDOM_STATE, VERBOSE
@@ -21,16 +29,8 @@ from ..utils._params import (
     check_signature_defaults,
     drop_auto,
 )
-from ._config import (
-    DEVICE_PARAMETER,
-    PRESET_PARAMETER,
-    check_knobs,
-    check_preset,
-    resolve_config,
-    size_config,
-)
+from ._config import resolve_config, size_config
 from ._fit import align_collection
-from ._knobs import ENGINE_METHODS, KNOBS
 from ._result import Alignment
 
 

@@ -33,6 +33,7 @@ from collections.abc import Callable
 import numpy as np
 import torch
 
+from .._settings import START_AXES
 from ..dtw import (
     check_window,
     coarse_collection,
@@ -117,7 +118,6 @@ def _smooth_monotone(warp: np.ndarray, sigma: float) -> np.ndarray:
 #: Time axes of the DTW start: ``"average"`` reparametrises the common axis so that the
 #: average warp is the identity (the mean has the average timing of the series);
 #: ``"reference"`` keeps the time axis of the reference (the medoid), as DBA's mean does.
-START_AXES = ("average", "reference")
 
 
 def reference_warps(warps: np.ndarray, n_points: int) -> np.ndarray:

@@ -39,12 +39,12 @@ from typing import Protocol, runtime_checkable
 import torch
 from torch import nn
 
+from .._settings import INITS
 from ._layout import GroupLayout
 
 #: Network initialisations: Xavier everywhere (RTW), zeros everywhere (NTW), or Xavier
 #: hidden layers with a zero readout (the warps start exactly at the identity while the
 #: hidden units differ, so the network is not confined to a linear function as with zeros).
-INITS = ("xavier", "zeros", "zero-readout")
 
 
 @runtime_checkable

@@ -11,7 +11,7 @@ from sklearn.utils import check_random_state, column_or_1d
 from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted
 
-from ..align._presets import PRESETS
+from .._settings import PRESETS
 from ..dtw import dtw_pairwise_distance
 from ..methods import FitContext, get_method
 from ..utils import check_series_collection

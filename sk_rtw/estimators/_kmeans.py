@@ -9,7 +9,7 @@ from sklearn.base import BaseEstimator, ClusterMixin, TransformerMixin
 from sklearn.utils import check_random_state
 from sklearn.utils.validation import check_is_fitted
 
-from ..align._config import DEVICE_PARAMETER, PRESET_PARAMETER
+from .._settings import DEVICE_PARAMETER, PRESET_PARAMETER
 from ..methods import FitContext, get_method
 from ..utils import check_series_collection
 from ..utils._common_params import DTW_WINDOW, MANIFOLD, N_JOBS, RANDOM_STATE, VERBOSE

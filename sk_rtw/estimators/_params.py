@@ -9,8 +9,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from ..align._config import DEVICE_PARAMETER, PRESET_PARAMETER, settings_table
-from ..align._knobs import owners
+from .._settings import DEVICE_PARAMETER, PRESET_PARAMETER, owners, settings_table
 from ..methods._registry import METHODS, method_parameter
 from ..utils._common_params import DTW_WINDOW as BAND
 from ..utils._common_params import MANIFOLD, N_JOBS, RANDOM_STATE, VERBOSE

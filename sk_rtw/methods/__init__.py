@@ -7,7 +7,7 @@ for the objects with every setting ``"auto"`` (the estimator's preset decides). 
 subclass of :class:`AveragingMethod` of your own is a ``method=`` value like these.
 """
 
-from ..align._presets import PRESETS
+from .._settings import PRESETS
 from ._base import RESULT_FIELDS, AveragingMethod, AveragingResult, FitContext
 from ._dba import DBA, DBAConfig
 from ._engine import NTW, RTW, TTW, EngineMethod

@@ -21,7 +21,7 @@ from typing import Any, ClassVar, Protocol, runtime_checkable
 import numpy as np
 from sklearn.base import BaseEstimator
 
-from ..align._knobs import ENGINE_METHODS, method_knobs, owners
+from .._settings import ENGINE_METHODS, method_knobs, owners
 from ..manifolds import Manifold
 from ..utils import SeriesCollection
 from ..utils._params import AUTO, validate_parameters

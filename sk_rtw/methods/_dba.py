@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 from joblib import Parallel, delayed
 
-from ..align._config import resolve_knobs
+from .._settings import resolve_knobs
 from ..baselines import dba_average
 from ..utils import SeriesCollection
 from ..utils._params import drop_auto

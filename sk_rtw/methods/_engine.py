@@ -7,9 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from ..align._config import AlignmentConfig, resolve_config, size_config
-from ..align._fit import align_collection
-from ..align._result import Alignment
+from ..align import Alignment, AlignmentConfig, align_collection, resolve_config, size_config
 from ..utils import SeriesCollection
 from ..utils._params import drop_auto
 from ._base import AveragingMethod, FitContext, method_class

@@ -3,7 +3,7 @@
 A :class:`Knob` is a declared parameter (name, accepted values, one-line doc with its
 unit) and its default for each method that has it: the paper's value (section V) for
 RTW, TTW and NTW, Petitjean et al.'s for DBA. A method has exactly the knobs that list
-it; a preset (:mod:`sk_rtw.align._presets`) changes some of these defaults. The
+it; a preset (:mod:`sk_rtw._settings._presets`) changes some of these defaults. The
 signature and docs of :func:`sk_rtw.align`, of the method objects
 (:class:`sk_rtw.methods.RTW`, ...) and their validation are built from this table.
 """
@@ -15,8 +15,11 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from ..utils._params import Boolean, Constant, Interval, Options, Parameter
-from ._start import START_AXES
-from ._warps import INITS
+
+#: Where the DTW start's warps are measured (``start_axis``).
+START_AXES = ("average", "reference")
+#: Initialisations of the warp networks (``init``).
+INITS = ("xavier", "zeros", "zero-readout")
 
 #: The alignment engine's methods (one optimisation loop, three configurations). The
 #: estimators' averaging methods, these and DBA, are registered in

@@ -1,7 +1,7 @@
 """The presets: each one frozen record of what it changes, its output-length rule included.
 
 A preset names a configuration of every method. The knobs' defaults
-(:mod:`sk_rtw.align._knobs`) are the paper's configuration; a preset holds only what it
+(:mod:`sk_rtw._settings._knobs`) are the paper's configuration; a preset holds only what it
 changes, for the engine's methods together (``engine``) and per method (``methods``),
 and the rule that gives the output length ``Z`` from the lengths of the series
 averaged together. A preset name means the same in :func:`sk_rtw.align` and in every
