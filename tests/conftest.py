@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pytest
 import torch
 
+from sk_rtw.align import tangent_sinc_interpolate
 from sk_rtw.manifolds import SPD, Euclidean, Product, Quaternion, Sphere
 from sk_rtw.methods import get_method
 
@@ -55,3 +57,18 @@ def quick(name: str = "rtw", **settings):
     method = get_method(name)
     own = method.get_params(deep=False)
     return method.set_params(**{**{k: v for k, v in QUICK.items() if k in own}, **settings})
+
+
+@dataclass(frozen=True)
+class CurvedLookingEuclidean(Euclidean):
+    """Euclidean geometry that does not declare itself flat: forces the general path."""
+
+    is_flat = False
+
+
+def interpolate(manifold, x, warps, window=10, refinements=0):
+    data = torch.as_tensor(np.asarray(x))[None]
+    w = torch.as_tensor(np.asarray(warps), dtype=torch.float64)[None]
+    return tangent_sinc_interpolate(
+        manifold, data, torch.tensor([len(x)]), w, window, refinements
+    )[0].numpy()
