@@ -98,12 +98,12 @@ def _reference_band_dtw(cost, lo, hi):
 def test_band_rows_match_a_reference_recursion(compiled, rng):
     from sk_rtw.dtw import point_cost_matrix
     from sk_rtw.dtw._costs import kernel_form
-    from sk_rtw.dtw._kernels import (
+    from sk_rtw.dtw._point_costs import segment_codes
+    from sk_rtw.dtw._pruned import (
         band_accumulated_cost,
         band_segment_cost,
         ragged_backtrack,
         ragged_value,
-        segment_codes,
     )
 
     manifold = Sphere(2)

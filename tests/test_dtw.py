@@ -205,7 +205,7 @@ def test_invalid_normalize_and_bad_series():
 
 
 def test_product_without_kernel_distance_uses_general_path():
-    from sk_rtw.dtw._kernels import segment_codes
+    from sk_rtw.dtw._point_costs import segment_codes
     from sk_rtw.dtw._spd_kernels import MAX_KERNEL_SIZE
 
     k = MAX_KERNEL_SIZE + 1
@@ -261,13 +261,13 @@ def test_a_guide_path_skips_cells_without_changing_the_path_or_cost(name):
     band: recomputed), and a close guide skips most cells and stores only what it
     computed."""
     from sk_rtw.datasets import make_warped_signals
-    from sk_rtw.dtw import _kernels, point_cost_matrix
+    from sk_rtw.dtw import _kernels, _point_costs, _pruned, point_cost_matrix
     from sk_rtw.dtw._costs import flat_points as _flat
     from sk_rtw.dtw._paths import path_indices
 
     data = make_warped_signals(name, 2, 300, random_state=4)
     M, x, y = data.manifold, data.signals[0], data.signals[1][:260]
-    segments = _kernels.segment_codes(M)
+    segments = _point_costs.segment_codes(M)
     fx, fy = _flat(x), _flat(y)
     staircase = np.stack([np.r_[np.arange(300), np.full(259, 299)],
                           np.r_[np.zeros(300, int), np.arange(1, 260)]], 1)  # fmt: skip
@@ -275,7 +275,7 @@ def test_a_guide_path_skips_cells_without_changing_the_path_or_cost(name):
     for window in (-1.0, 0.2):
         for squared in (True, False):
             full = _kernels.accumulated_cost(point_cost_matrix(x, y, M, squared), window)
-            stored = _kernels.accumulated_segment_cost(fx, fy, segments, squared, window,
+            stored = _pruned.accumulated_segment_cost(fx, fy, segments, squared, window,
                                                        np.inf)  # fmt: skip
             np.testing.assert_array_equal(dense(stored, 300, 260), full)
             best = np.asarray(_kernels.backtrack(full), dtype=np.int64).reshape(-1, 2)
@@ -283,16 +283,16 @@ def test_a_guide_path_skips_cells_without_changing_the_path_or_cost(name):
                 path, cost = path_indices(x, y, M, window, squared, guide)
                 np.testing.assert_array_equal(path, best)
                 assert cost == full[-1, -1]
-                bound = _kernels.path_cost(fx, fy, guide, segments, squared)
-                rows = _kernels.accumulated_segment_cost(fx, fy, segments, squared, window,
+                bound = _point_costs.path_cost(fx, fy, guide, segments, squared)
+                rows = _pruned.accumulated_segment_cost(fx, fy, segments, squared, window,
                                                          bound)  # fmt: skip
                 pruned = dense(rows, 300, 260)
                 under = full <= bound
                 np.testing.assert_array_equal(pruned[under], full[under])
                 assert np.all(pruned[~under] >= full[~under])
-            bound = _kernels.path_cost(fx, fy, best, segments, squared)
+            bound = _point_costs.path_cost(fx, fy, best, segments, squared)
             assert bound == full[-1, -1]  # the recursion's value of its own path
-            rows = _kernels.accumulated_segment_cost(fx, fy, segments, squared, window, bound)
+            rows = _pruned.accumulated_segment_cost(fx, fy, segments, squared, window, bound)
             if window < 0:  # without a band: 28-60 % of the cells here (0.4 % at T = 4,000)
                 assert len(rows[0]) < 0.7 * np.isfinite(full).sum()
 
@@ -300,21 +300,21 @@ def test_a_guide_path_skips_cells_without_changing_the_path_or_cost(name):
 def test_pairwise_distances_with_bounds_equal_those_without(rng):
     """Bounds from any path (close, poor, or too low to be a path's cost) give the same
     distances: a bound under the distance is detected and the pair computed again."""
-    from sk_rtw.dtw import _kernels
+    from sk_rtw.dtw import _point_costs, _pruned
 
     Q = Quaternion()
     X = np.stack([random_walk(Q, 40, seed) for seed in range(5)])
-    lengths, segments = np.full(5, 40), _kernels.segment_codes(Q)
+    lengths, segments = np.full(5, 40), _point_costs.segment_codes(Q)
     for window in (None, 0.3):
         plain = dtw_pairwise_distance(X, manifold=Q, squared=True, window=window)
         w = -1.0 if window is None else window
         for scale in (1.0, 1.5, 0.5, 0.0):
             bounds = plain * scale + (rng.random(plain.shape) * 1e-3 if scale else 0.0)
-            got = _kernels.pairwise_segments(X, lengths, X, lengths, segments, True, w, True,
+            got = _pruned.pairwise_segments(X, lengths, X, lengths, segments, True, w, True,
                                              bounds)  # fmt: skip
             np.testing.assert_array_equal(got, plain)
     low = plain[0, 1] * 0.5
-    assert _kernels.pruned_distance(X[0], X[1], segments, True, -1.0, low) > low
+    assert _pruned.pruned_distance(X[0], X[1], segments, True, -1.0, low) > low
 
 
 def test_long_pairs_are_bounded_by_their_coarse_to_fine_path_with_the_same_result():
@@ -322,14 +322,14 @@ def test_long_pairs_are_bounded_by_their_coarse_to_fine_path_with_the_same_resul
     bound each pair by its coarse-to-fine path (two rows of memory, most cells skipped)
     and return what the full recursion returns, bit for bit."""
     from sk_rtw.datasets import make_warped_signals
-    from sk_rtw.dtw import _kernels
+    from sk_rtw.dtw import _point_costs, _pruned
     from sk_rtw.dtw._band import guide_bound
 
     Q = Quaternion()
     X = np.asarray(make_warped_signals("quaternion", 3, 1100, random_state=2).signals)
     X = [X[0], X[1][:1050], X[2]]
-    segments = _kernels.segment_codes(Q)
-    full = np.array([[_kernels.pruned_distance(a, b, segments, False, -1.0, np.inf)
+    segments = _point_costs.segment_codes(Q)
+    full = np.array([[_pruned.pruned_distance(a, b, segments, False, -1.0, np.inf)
                       for b in X] for a in X])  # fmt: skip
     assert np.isfinite(guide_bound(X[0], X[1], Q, -1.0, False))  # long: a guide is used
     assert guide_bound(X[0], X[1], Q, 0.5, False) == np.inf  # in a band: none

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from sk_rtw import dtw_nearest_distance, dtw_pairwise_distance
-from sk_rtw.dtw import _kernels, _search
+from sk_rtw.dtw import _kernels, _point_costs, _search
 from sk_rtw.manifolds import SPD, Euclidean, Product, Quaternion, Sphere
 from sk_rtw.utils import check_series_collection
 
@@ -50,7 +50,7 @@ def test_the_envelope_spans_the_band_of_every_column(nx, ny, window, rng):
 @pytest.mark.parametrize("squared", [False, True])
 @pytest.mark.parametrize("manifold", KERNEL_MANIFOLDS, ids=repr)
 def test_lb_keogh_bounds_dtw_from_below(manifold, squared):
-    segments = _kernels.segment_codes(manifold)
+    segments = _point_costs.segment_codes(manifold)
     tight = 0
     for seed, window in enumerate([0.0, 0.05, 0.2, None] * 5):
         x, y = walks(manifold, (25, 18 + seed % 15), 100 * seed)
@@ -68,7 +68,7 @@ def test_lb_keogh_bounds_dtw_from_below(manifold, squared):
 def test_lb_keogh_of_a_series_against_itself_is_zero_and_exact_without_warping(rng):
     x = rng.standard_normal((30, 1))
     y = rng.standard_normal((30, 1))
-    segments = _kernels.segment_codes(Euclidean(1))
+    segments = _point_costs.segment_codes(Euclidean(1))
     lower, upper = np.empty((30, 1)), np.empty((30, 1))
     _search.query_envelope(x, 30, 0.0, lower, upper)
     assert _search.lb_keogh(x, lower, upper, segments, False) == 0.0

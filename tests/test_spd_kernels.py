@@ -8,7 +8,8 @@ import pytest
 from numba import njit
 
 from sk_rtw import dtw_distance, dtw_nearest_distance, dtw_pairwise_distance
-from sk_rtw.dtw._kernels import final_cost, kernel_points, segment_codes
+from sk_rtw.dtw._kernels import final_cost
+from sk_rtw.dtw._point_costs import kernel_points, segment_codes
 from sk_rtw.dtw._spd_kernels import spd_squared_distance
 from sk_rtw.manifolds import SPD, Euclidean, Product
 

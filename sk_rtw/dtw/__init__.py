@@ -13,10 +13,12 @@ midpoints) and :func:`soft_dtw_batch` (soft-DTW values and expected alignments).
 :func:`dtw_nearest_distance` finds the nearest series of every group with lower bounds
 and early abandoning.
 
-The modules stand on floors, each importing only those below it: the compiled kernels
-(``_kernels``, ``_spd_kernels``, ``_soft``); point costs and the optimal path through
-them (``_costs``); the coarse-to-fine band (``_band``); paths between series
-(``_paths``); the distances (``_dtw``); their consumers (``_medoid``, ``_search``).
+The modules stand on floors, each importing only those below it: the compiled point
+costs (``_spd_kernels``, ``_point_costs``); the compiled recursion (``_kernels``, and
+``_pruned`` with the point costs inside it; ``_soft``); point-cost matrices and the
+optimal path through them (``_costs``); the coarse-to-fine band (``_band``); paths
+between series (``_paths``); the distances (``_dtw``); their consumers (``_medoid``,
+``_search``).
 """
 
 from ._band import coarse_collection, multiscale_path, solved_exactly

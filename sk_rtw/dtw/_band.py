@@ -13,8 +13,8 @@ in the rare case that the optimal path leaves the band it is a close approximati
 Band layout: row ``i`` holds the columns ``lo[i] <= j < hi[i]``; ``lo`` and ``hi`` are
 non-decreasing, so the band is a staircase that connects ``(0, 0)`` with
 ``(T_x - 1, T_y - 1)``. The recursion, its storage by rows and the tie rule on the way
-back are the kernels' (:func:`~._kernels.band_segment_cost`,
-:func:`~._kernels.ragged_backtrack`), as for every other DTW path of the package.
+back are the kernels' (:func:`~._pruned.band_segment_cost`,
+:func:`~._pruned.ragged_backtrack`), as for every other DTW path of the package.
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ from numba import njit
 
 from ..manifolds import Manifold
 from ..utils import SeriesCollection
-from . import _kernels
+from . import _point_costs, _pruned
 from ._costs import kernel_form, optimal_path, point_cost_matrix
 
 #: Pairs with at most this many cells get the exact path.
@@ -113,15 +113,15 @@ def coarse_collection(series: list[np.ndarray], manifold: Manifold, length: int)
 def _band_rows(x, y, lo, hi, manifold, squared):
     """The accumulated cost of the band's cells, stored by rows (the kernels'
     ``(values, offsets, starts)``)."""
-    segments = _kernels.segment_codes(manifold)
+    segments = _point_costs.segment_codes(manifold)
     if segments is not None:
-        return _kernels.band_segment_cost(kernel_form(x, manifold), kernel_form(y, manifold),
+        return _pruned.band_segment_cost(kernel_form(x, manifold), kernel_form(y, manifold),
                                           segments, squared, lo, hi)  # fmt: skip
     rows = np.repeat(np.arange(len(x)), hi - lo)
     cols = lo[rows] + np.arange(rows.size) - np.repeat(np.cumsum(hi - lo) - (hi - lo), hi - lo)
     with torch.no_grad():
         values = manifold._dist(torch.as_tensor(x[rows]), torch.as_tensor(y[cols])).numpy()
-    return _kernels.band_accumulated_cost(values * values if squared else values, lo, hi)
+    return _pruned.band_accumulated_cost(values * values if squared else values, lo, hi)
 
 
 def solved_exactly(nx: int, ny: int, radius: int = RADIUS, exact_cells: int = EXACT_CELLS):
@@ -176,8 +176,8 @@ def multiscale_path(
                                 radius, exact_cells)  # fmt: skip
     lo, hi = band_from_path(coarse, len(x), len(y), radius)
     rows = _band_rows(x, y, lo, hi, manifold, squared)
-    cost = _kernels.ragged_value(*rows, len(x) - 1, len(y) - 1)
-    return _kernels.ragged_backtrack(*rows, len(y)), float(cost)
+    cost = _pruned.ragged_value(*rows, len(x) - 1, len(y) - 1)
+    return _pruned.ragged_backtrack(*rows, len(y)), float(cost)
 
 
 def guide_bound(
@@ -192,13 +192,13 @@ def guide_bound(
     :func:`multiscale_path` if they are long, over :data:`EXACT_CELLS` cells, and have no
     band): a bound that lets the exact DTW skip most cells. ``inf`` without a guide or a
     kernel distance."""
-    segments = _kernels.segment_codes(manifold)
+    segments = _point_costs.segment_codes(manifold)
     if segments is None:
         return np.inf
     if guide is None and (window < 0.0 or window >= 1.0) and len(x) * len(y) > EXACT_CELLS:
         guide = multiscale_path(x, y, manifold, squared)[0]
     if guide is None:
         return np.inf
-    cost = _kernels.path_cost(kernel_form(x, manifold), kernel_form(y, manifold),
+    cost = _point_costs.path_cost(kernel_form(x, manifold), kernel_form(y, manifold),
                               np.asarray(guide, dtype=np.int64), segments, squared)  # fmt: skip
     return cost * (1.0 + GUIDE_SLACK)

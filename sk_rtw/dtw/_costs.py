@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..manifolds import Manifold
-from . import _kernels
+from . import _kernels, _point_costs
 
 
 def flat_points(x: np.ndarray) -> np.ndarray:
@@ -19,8 +19,8 @@ def flat_points(x: np.ndarray) -> np.ndarray:
 
 
 def kernel_form(x: np.ndarray, manifold: Manifold) -> np.ndarray:
-    """A validated series in the kernels' form (:func:`~._kernels.kernel_points`)."""
-    return _kernels.kernel_points(manifold, flat_points(x))
+    """A validated series in the kernels' form (:func:`~._point_costs.kernel_points`)."""
+    return _point_costs.kernel_points(manifold, flat_points(x))
 
 
 def point_cost_matrix(
@@ -39,10 +39,10 @@ def point_cost_matrix(
     -------
     C : ndarray of shape (T_x, T_y)
     """
-    segments = _kernels.segment_codes(manifold)
+    segments = _point_costs.segment_codes(manifold)
     if segments is not None:
         out = np.empty((len(x), len(y)))
-        _kernels.segment_cost_matrix(kernel_form(x, manifold), kernel_form(y, manifold),
+        _point_costs.segment_cost_matrix(kernel_form(x, manifold), kernel_form(y, manifold),
                                      len(x), len(y), segments, squared, out)  # fmt: skip
         return out
     cost = np.asarray(manifold.pairwise_dist(x, y))

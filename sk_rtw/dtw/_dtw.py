@@ -16,7 +16,7 @@ from .._numba import numba_threads
 from ..manifolds import Manifold
 from ..utils import SeriesCollection, check_series, check_series_collection
 from ..utils._common_params import DTW_WINDOW
-from . import _kernels
+from . import _kernels, _point_costs, _pruned
 from ._band import EXACT_CELLS, guide_bound
 from ._costs import check_costs, kernel_form, point_cost_matrix
 from ._paths import path_indices
@@ -140,7 +140,7 @@ def dtw_distance(
     if normalize == "path":
         path, cost = path_indices(x, y, manifold, w, squared)
         return float(cost / len(path))
-    segments = _kernels.segment_codes(manifold)
+    segments = _point_costs.segment_codes(manifold)
     if segments is None:
         return float(_kernels.final_cost(point_cost_matrix(x, y, manifold, squared),
                                          len(x), len(y), w))  # fmt: skip
@@ -148,9 +148,9 @@ def dtw_distance(
     # coarse-to-fine path (the same value)
     bound = guide_bound(x, y, manifold, w, squared)
     fx, fy = kernel_form(x, manifold), kernel_form(y, manifold)
-    value = _kernels.pruned_distance(fx, fy, segments, squared, w, bound)
+    value = _pruned.pruned_distance(fx, fy, segments, squared, w, bound)
     if not value <= bound:
-        value = _kernels.pruned_distance(fx, fy, segments, squared, w, np.inf)
+        value = _pruned.pruned_distance(fx, fy, segments, squared, w, np.inf)
     return float(value)
 
 
@@ -235,13 +235,13 @@ def _pairwise(
     """The distances of :func:`dtw_pairwise_distance` (long pairs without a band skip the
     cells that cannot beat their coarse-to-fine path: :func:`_guide_bounds`)."""
     manifold = cx.manifold
-    segments = _kernels.segment_codes(manifold)
+    segments = _point_costs.segment_codes(manifold)
     if segments is not None:
-        flat_x = _kernels.kernel_series(cx)
-        flat_y = _kernels.kernel_series(cy)
+        flat_x = _point_costs.kernel_series(cx)
+        flat_y = _point_costs.kernel_series(cy)
         if not per_step:
             bounds = _guide_bounds(cx, cy, window, squared, symmetric)
-            return _kernels.pairwise_segments(
+            return _pruned.pairwise_segments(
                 flat_x, cx.lengths, flat_y, cy.lengths, segments, squared, window, symmetric,
                 bounds,
             )  # fmt: skip
@@ -255,7 +255,7 @@ def _pairwise(
         for start in range(0, len(js), block):
             chunk = js[start : start + block]
             if segments is not None:
-                cost = _kernels.segment_cost_stack(
+                cost = _point_costs.segment_cost_stack(
                     flat_x[i],
                     flat_y[chunk],
                     cx.lengths[i],

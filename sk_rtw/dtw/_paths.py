@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..manifolds import Manifold
-from . import _kernels
+from . import _point_costs, _pruned
 from ._band import guide_bound
 from ._costs import kernel_form, optimal_path, point_cost_matrix
 
@@ -43,27 +43,27 @@ def path_indices(
     path : ndarray of shape (P, 2), int
     cost : float
     """
-    segments = _kernels.segment_codes(manifold)
+    segments = _point_costs.segment_codes(manifold)
     if segments is None:
         return optimal_path(point_cost_matrix(x, y, manifold, squared), window)
     # the point costs are computed inside the accumulation (the T_x x T_y cost matrix is
     # never stored) and only where a path could still beat the guide's cost
     fx, fy = kernel_form(x, manifold), kernel_form(y, manifold)
     bound = guide_bound(x, y, manifold, window, squared, guide)
-    rows = _kernels.accumulated_segment_cost(fx, fy, segments, squared, window, bound)
-    cost = _kernels.ragged_value(*rows, len(x) - 1, len(y) - 1)
+    rows = _pruned.accumulated_segment_cost(fx, fy, segments, squared, window, bound)
+    cost = _pruned.ragged_value(*rows, len(x) - 1, len(y) - 1)
     if not cost <= bound:  # the guide left the band, or a cost is not finite
-        rows = _kernels.accumulated_segment_cost(fx, fy, segments, squared, window, np.inf)
-        cost = _kernels.ragged_value(*rows, len(x) - 1, len(y) - 1)
+        rows = _pruned.accumulated_segment_cost(fx, fy, segments, squared, window, np.inf)
+        cost = _pruned.ragged_value(*rows, len(x) - 1, len(y) - 1)
     if not np.isfinite(cost):  # the full cost matrix says why
         return optimal_path(point_cost_matrix(x, y, manifold, squared), window)
-    return _kernels.ragged_backtrack(*rows, len(y)), float(cost)
+    return _pruned.ragged_backtrack(*rows, len(y)), float(cost)
 
 
 def has_compiled_costs(manifold: Manifold) -> bool:
     """Whether the compiled kernels compute ``manifold``'s point costs themselves (then
     :func:`mean_matched_positions` applies)."""
-    return _kernels.segment_codes(manifold) is not None
+    return _point_costs.segment_codes(manifold) is not None
 
 
 def mean_matched_positions(
@@ -102,15 +102,15 @@ def mean_matched_positions(
         Row ``n`` holds ``reference_lengths[codes[n]]`` values (the rest is zero); the
         paths are those of :func:`path_indices` (ties broken alike).
     """
-    segments = _kernels.segment_codes(manifold)
+    segments = _point_costs.segment_codes(manifold)
     if segments is None:
         raise ValueError(f"{manifold!r} has no compiled point costs")
 
     def form(a: np.ndarray) -> np.ndarray:
         flat = a.reshape(a.shape[0], a.shape[1], -1)
-        return np.ascontiguousarray(_kernels.kernel_points(manifold, flat))
+        return np.ascontiguousarray(_point_costs.kernel_points(manifold, flat))
 
-    return _kernels.matched_positions(
+    return _pruned.matched_positions(
         form(references), np.asarray(reference_lengths), form(series), np.asarray(lengths),
         np.asarray(codes), segments, squared, window,
     )  # fmt: skip

@@ -23,7 +23,7 @@ every pair; :func:`nearest_by_class` computes the same values with far fewer cel
    ``predict``; whether another class is nearer than a series' own), the best distance
    over all classes is the threshold, and far classes are never searched to their end.
 3. **Early abandoning**: the DTW of a visited reference is computed with that threshold
-   as a bound (:func:`~sk_rtw.dtw._kernels.pruned_distance`, PrunedDTW): cells that
+   as a bound (:func:`~sk_rtw.dtw._pruned.pruned_distance`, PrunedDTW): cells that
    cannot beat it are skipped, and the pair stops as soon as no path can.
 
 The distances returned are those of the exhaustive search bit for bit: a reference that
@@ -44,7 +44,7 @@ from numba import njit, prange
 from .._numba import numba_threads
 from ..manifolds import Manifold
 from ..utils import SeriesCollection, check_series_collection
-from . import _kernels
+from . import _kernels, _point_costs, _pruned
 from ._dtw import check_window, dtw_pairwise_distance
 
 _INF = np.inf
@@ -133,7 +133,7 @@ def lb_keogh(y, lower, upper, segments, squared):
     ny = y.shape[0]
     total = 0.0
     n_segments = segments.shape[0]
-    univariate = n_segments == 1 and segments[0, 2] == _kernels.SEGMENT_EUCLIDEAN and (
+    univariate = n_segments == 1 and segments[0, 2] == _point_costs.SEGMENT_EUCLIDEAN and (
         segments[0, 1] == 1
     )
     for j in range(ny):
@@ -145,18 +145,18 @@ def lb_keogh(y, lower, upper, segments, squared):
             for s in range(n_segments):
                 start, stop, code = segments[s, 0], segments[s, 1], segments[s, 2]
                 near = 0.0
-                if code >= _kernels.SEGMENT_SPD2:  # the sorted log-eigenvalues
-                    stop = start + _kernels.spd_size(code)
+                if code >= _point_costs.SEGMENT_SPD2:  # the sorted log-eigenvalues
+                    stop = start + _point_costs.spd_size(code)
                 for k in range(start, stop):
                     gap = _outside(y[j, k], lower[j, k], upper[j, k])
                     near += gap * gap
-                if code == _kernels.SEGMENT_EUCLIDEAN:
+                if code == _point_costs.SEGMENT_EUCLIDEAN:
                     sq += near
                     continue
-                if code >= _kernels.SEGMENT_SPD2:
+                if code >= _point_costs.SEGMENT_SPD2:
                     sq += near * SPD_BOUND_SHRINK
                     continue
-                if code == _kernels.SEGMENT_SIGN_INVARIANT_SPHERE:
+                if code == _point_costs.SEGMENT_SIGN_INVARIANT_SPHERE:
                     flipped = 0.0  # the envelope of -x is [-upper, -lower]
                     for k in range(start, stop):
                         gap = _outside(y[j, k], -upper[j, k], -lower[j, k])
@@ -220,7 +220,7 @@ def nearest_by_class(
             threshold = min(best[c], limits[q]) if every_class else nearest
             if bound > threshold:
                 continue
-            value = _kernels.pruned_distance(x, R[r, : lr[r]], segments, squared, window,
+            value = _pruned.pruned_distance(x, R[r, : lr[r]], segments, squared, window,
                                              threshold)  # fmt: skip
             computed[q] += 1
             if value <= threshold and value < best[c]:
@@ -332,7 +332,7 @@ def _nearest(X, Y, groups, manifold, window, squared, exclude, exclude_group, ma
     limits = np.ascontiguousarray(limits, dtype=np.float64)
     if np.isnan(limits).any():
         raise ValueError("max_distance must not be NaN")
-    segments = _kernels.segment_codes(cx.manifold)
+    segments = _point_costs.segment_codes(cx.manifold)
     if segments is None:
         distances = dtw_pairwise_distance(cx, cy, window=window, squared=squared,
                                           n_jobs=n_jobs)  # fmt: skip
@@ -347,7 +347,7 @@ def _nearest(X, Y, groups, manifold, window, squared, exclude, exclude_group, ma
         return out, np.full(n, m, dtype=np.int64)
     with numba_threads(n_jobs):
         return nearest_by_class(
-            _kernels.kernel_series(cx), cx.lengths, _kernels.kernel_series(cy), cy.lengths,
+            _point_costs.kernel_series(cx), cx.lengths, _point_costs.kernel_series(cy), cy.lengths,
             owners, n_groups, skip,
             skip_group, limits, not nearest_only, segments, bool(squared), w,
         )  # fmt: skip

@@ -1,0 +1,272 @@
+"""The DTW recursion with its point costs computed inside it (:func:`~._point_costs.
+_cost_row`, a row at a time, so the cost matrix is never stored), pruned by a bound and
+stored by rows.
+
+Given the cost of some path (a bound), the rows skip the cells that cannot beat it and
+store only what they compute (:func:`_pruned_row`): the result is the same. Rows are
+stored ragged (``values``, ``offsets``, ``starts``; :func:`ragged_value` reads a cell,
+:func:`ragged_backtrack` the path), in a Sakoe-Chiba band or any staircase band
+(:func:`band_segment_cost`). The pairwise and matched-position kernels run many pairs in
+one compiled call.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+from ._kernels import _band_row, _cell, _two_rows, choose_step, sakoe_chiba_rows
+from ._point_costs import _cost_row
+
+_INF = np.inf
+
+
+#: Point costs of a pruned row are computed this many columns at a time (vectorised as in
+#: :func:`_cost_row`); a row that stops early wastes at most this many.
+PRUNE_CHUNK = 32
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _pruned_row(x, y, i, prev, cur, costs, lo, hi, reach, bound, segments, squared):
+    """Row ``i`` of the accumulated cost into ``cur`` (padded as in :func:`_accumulate_row`)
+    from column ``lo`` on, skipping what cannot beat ``bound`` (PrunedDTW: Silva and
+    Batista, 2016). ``costs`` is a scratch row of at least ``hi`` entries.
+
+    A cell is "kept" when its accumulated cost is at most ``bound``. ``reach`` is the last
+    kept column of the row above plus one: past it the cells above and above-left exceed
+    the bound, so the first cell there that exceeds it ends the row (every cell to its
+    right would too). Returns the first and last kept columns (-1 if none) and the last
+    column written.
+    """
+    if bound == _INF:  # nothing to skip: the plain recursion
+        _cost_row(x, y[lo:hi], i, hi - lo, segments, squared, costs[lo:hi])
+        _band_row(costs, prev, cur, lo, hi)
+        return lo, hi - 1, hi - 1
+    left = _INF
+    first, last = -1, -1
+    for chunk in range(lo, hi, PRUNE_CHUNK):
+        stop = min(hi, chunk + PRUNE_CHUNK)
+        _cost_row(x, y[chunk:stop], i, stop - chunk, segments, squared, costs[chunk:stop])
+        for j in range(chunk, stop):
+            left = _cell(prev, left, j, costs[j])
+            cur[j + 1] = left
+            if left <= bound:
+                if first < 0:
+                    first = j
+                last = j
+            elif j >= reach:
+                return first, last, j
+    return first, last, hi - 1
+
+
+@njit(cache=True, nogil=True)
+def accumulated_segment_cost(x, y, segments, squared, window, bound):
+    """The accumulated cost of flattened series ``x`` and ``y`` where a path of cost at
+    most ``bound`` can pass, stored row by row (:func:`_pruned_row`; ``inf``: every cell
+    of the band).
+
+    Every cell whose accumulated cost is at most ``bound`` holds the value of
+    :func:`accumulated_cost` of :func:`segment_cost_matrix`, bit for bit; every other
+    cell holds that value or more (``inf`` where skipped). So when the last cell is at
+    most ``bound`` (the cost of any path inside the band bounds it), it and the optimal
+    path backtracked from it are the exact ones; otherwise the bound was too low and the
+    caller recomputes with ``inf``. Row ``i`` starts at the first kept column of row
+    ``i - 1``: the cells computed are a band around the paths cheaper than the bound, and
+    only they are stored (memory in proportion to them, not to ``T_x T_y``).
+
+    Returns ``(values, offsets, starts)``: row ``i`` holds columns ``starts[i]`` onwards
+    in ``values[offsets[i]:offsets[i + 1]]`` (:func:`ragged_value` reads a cell).
+    """
+    lo, hi = sakoe_chiba_rows(x.shape[0], y.shape[0], window)
+    return _pruned_rows(x, y, segments, squared, lo, hi, bound, True)[:3]
+
+
+@njit(cache=True, nogil=True)
+def band_segment_cost(x, y, segments, squared, lo, hi):
+    """:func:`accumulated_segment_cost` in any staircase band: row ``i`` holds the columns
+    ``lo[i] <= j < hi[i]`` (``lo`` and ``hi`` non-decreasing, ``lo[0] = 0``,
+    ``hi[-1] = len(y)``), every cell of it computed; the same ``(values, offsets,
+    starts)`` rows."""
+    return _pruned_rows(x, y, segments, squared, lo, hi, _INF, True)[:3]
+
+
+@njit(cache=True, nogil=True)
+def band_accumulated_cost(costs, lo, hi):
+    """:func:`band_segment_cost` from point costs computed elsewhere: ``costs`` holds the
+    band's cells row after row (row ``i``: columns ``lo[i]`` to ``hi[i] - 1``). Returns
+    the same ``(values, offsets, starts)`` rows (:func:`ragged_value` reads a cell)."""
+    nx, ny = lo.shape[0], hi[-1]
+    prev, cur = _two_rows(ny)
+    row = np.empty(ny)
+    values = np.empty(costs.shape[0])
+    offsets = np.zeros(nx + 1, dtype=np.int64)
+    for i in range(nx):
+        offsets[i + 1] = offsets[i] + hi[i] - lo[i]
+        row[lo[i] : hi[i]] = costs[offsets[i] : offsets[i + 1]]
+        _band_row(row, prev, cur, lo[i], hi[i])
+        values[offsets[i] : offsets[i + 1]] = cur[lo[i] + 1 : hi[i] + 1]
+        prev, cur = cur, prev
+    return values, offsets, lo.copy()
+
+
+@njit(cache=True, nogil=True)
+def pruned_distance(x, y, segments, squared, window, bound):
+    """The DTW distance of flattened series ``x`` and ``y`` in two rows of memory, the
+    cells that cannot beat ``bound`` skipped as in :func:`accumulated_segment_cost`:
+    exact when at most ``bound``, otherwise some value above it (``inf`` if the bound
+    was too low)."""
+    if bound == _INF:  # the plain recursion, without the pruning's bookkeeping per row
+        lo, hi = sakoe_chiba_rows(x.shape[0], y.shape[0], window)
+        prev, cur = _two_rows(y.shape[0])
+        costs = np.empty(y.shape[0])
+        for i in range(x.shape[0]):
+            _cost_row(x, y[lo[i] : hi[i]], i, hi[i] - lo[i], segments, squared,
+                      costs[lo[i] : hi[i]])  # fmt: skip
+            _band_row(costs, prev, cur, lo[i], hi[i])
+            prev, cur = cur, prev
+        return prev[y.shape[0]]
+    lo, hi = sakoe_chiba_rows(x.shape[0], y.shape[0], window)
+    return _pruned_rows(x, y, segments, squared, lo, hi, bound, False)[3]
+
+
+@njit(cache=True, nogil=True)
+def _pruned_rows(x, y, segments, squared, lo, hi, bound, store):
+    """Rows of the accumulated cost in two buffers, each kept in ``values`` if ``store``:
+    ``(values, offsets, starts, last cell)`` (see :func:`accumulated_segment_cost`), in
+    the staircase band ``[lo[i], hi[i])``."""
+    nx, ny = x.shape[0], y.shape[0]
+    prev, cur = _two_rows(ny)
+    costs = np.empty(ny)
+    rows = nx if store else 0  # a distance alone allocates nothing per row
+    values = np.empty(min(nx * ny, max(1 << 16, 64 * (nx + ny))) if store else 0)
+    offsets = np.zeros(rows + 1, dtype=np.int64)
+    starts = np.zeros(rows, dtype=np.int64)
+    start, reach = 0, 0  # row -1 keeps only its sentinel (column -1)
+    prev_end, cur_end = 0, 0  # the last padded entry each buffer holds a value in
+    for i in range(nx):
+        a = max(lo[i], start)
+        cur[a] = _INF  # column a - 1, which the next row reads and this one does not write
+        first, last, written = _pruned_row(
+            x, y, i, prev, cur, costs, a, hi[i], reach, bound, segments, squared
+        )
+        for k in range(written + 2, cur_end + 1):  # what two rows ago left further right
+            cur[k] = _INF
+        cur_end = max(written + 1, a)
+        if store:
+            n = written - a + 1
+            if offsets[i] + n > values.shape[0]:  # grow by doubling
+                grown = np.empty(max(2 * values.shape[0], offsets[i] + n))
+                grown[: offsets[i]] = values[: offsets[i]]
+                values = grown
+            values[offsets[i] : offsets[i] + n] = cur[a + 1 : written + 2]
+            starts[i], offsets[i + 1] = a, offsets[i] + n
+        if first < 0:  # no cell of this row is kept: nor is the last cell
+            if store:
+                offsets[i + 2 :] = offsets[i + 1]
+            return values[: offsets[rows]], offsets, starts, _INF
+        start, reach = first, last + 1
+        prev, cur = cur, prev
+        prev_end, cur_end = cur_end, prev_end
+    return values[: offsets[rows]], offsets, starts, prev[ny]
+
+
+@njit(cache=True, nogil=True, inline="always")
+def ragged_value(values, offsets, starts, i, j):
+    """Cell ``(i, j)`` of :func:`accumulated_segment_cost`'s rows (``inf`` if not stored)."""
+    k = j - starts[i]
+    if k < 0 or k >= offsets[i + 1] - offsets[i]:
+        return _INF
+    return values[offsets[i] + k]
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _ragged_step(values, offsets, starts, i, j):
+    """The cell before ``(i, j)`` on the optimal path through stored rows."""
+    if i == 0:
+        return i, j - 1
+    if j == 0:
+        return i - 1, j
+    return choose_step(
+        i, j,
+        ragged_value(values, offsets, starts, i - 1, j - 1),
+        ragged_value(values, offsets, starts, i - 1, j),
+        ragged_value(values, offsets, starts, i, j - 1),
+    )  # fmt: skip
+
+
+@njit(cache=True, nogil=True)
+def ragged_backtrack(values, offsets, starts, ny):
+    """The optimal path ``(P, 2)`` through :func:`accumulated_segment_cost`'s rows, ties
+    broken as :func:`backtrack` breaks them."""
+    nx = starts.shape[0]
+    i, j = nx - 1, ny - 1
+    path = np.empty((nx + ny - 1, 2), dtype=np.int64)
+    n = 0
+    path[n, 0], path[n, 1] = i, j
+    while i > 0 or j > 0:
+        i, j = _ragged_step(values, offsets, starts, i, j)
+        n += 1
+        path[n, 0], path[n, 1] = i, j
+    return path[: n + 1][::-1].copy()
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def pairwise_segments(X, lx, Y, ly, segments, squared, window, symmetric, bounds):
+    """DTW between every series of ``X`` and of ``Y``, the cost rows computed in numba.
+
+    Each cost row is computed just before the recursion consumes it, so the cost matrix
+    never leaves the cache, and only within the band: a narrow band costs its width.
+    ``bounds[i, j]`` is the cost of some path between the pair (``inf``: none known); the
+    cells that cannot beat it are skipped (:func:`pruned_distance`; the pair is computed
+    again without it if it was too low). Returns the distances, shape ``(len(X), len(Y))``.
+    """
+    n, m = X.shape[0], Y.shape[0]
+    values = np.zeros((n, m))
+    for k in prange(n * m):
+        i = k // m
+        j = k - i * m
+        if symmetric and j <= i:
+            continue
+        x, y = X[i, : lx[i]], Y[j, : ly[j]]
+        value = pruned_distance(x, y, segments, squared, window, bounds[i, j])
+        if not value <= bounds[i, j]:
+            value = pruned_distance(x, y, segments, squared, window, _INF)
+        values[i, j] = value
+    if symmetric:
+        for i in range(n):
+            for j in range(i):
+                values[i, j] = values[j, i]
+    return values
+
+
+@njit(cache=True, nogil=True)
+def matched_positions(references, reference_lengths, X, lengths, codes, segments, squared,
+                      window):  # fmt: skip
+    """For every series, the mean index of its samples matched with each sample of its
+    reference on their optimal DTW path (the path of :func:`accumulated_segment_cost`
+    without a bound, ties broken as :func:`backtrack` breaks them).
+
+    ``references`` ``(G, L, p)`` with ``reference_lengths``; series ``X`` ``(N, T, p)``
+    with ``lengths``, series ``n`` aligned to reference ``codes[n]``. Returns ``(N, L)``:
+    row ``n`` holds ``reference_lengths[codes[n]]`` values (the rest is zero). One pass,
+    no path stored: every pair costs its DTW and nothing else.
+    """
+    n = X.shape[0]
+    out = np.zeros((n, references.shape[1]))
+    counts = np.zeros(references.shape[1])
+    for k in range(n):
+        reference = references[codes[k], : reference_lengths[codes[k]]]
+        nx, ny = reference.shape[0], lengths[k]
+        values, offsets, starts = accumulated_segment_cost(
+            reference, X[k, :ny], segments, squared, window, _INF
+        )
+        counts[:nx] = 0.0
+        i, j = nx - 1, ny - 1
+        out[k, i], counts[i] = j, 1.0
+        while i > 0 or j > 0:
+            i, j = _ragged_step(values, offsets, starts, i, j)
+            out[k, i] += j
+            counts[i] += 1.0
+        for i in range(nx):
+            out[k, i] /= counts[i]
+    return out
