@@ -24,10 +24,11 @@ from ._config import AlignmentConfig
 from ._layout import GroupLayout
 from ._memory import check_memory
 from ._narrowing import BatchOptimisation
-from ._problem import Problem, build_warps, check_finite, output_length
+from ._problem import Problem, check_finite, output_length
 from ._refine import refine_mean
 from ._result import Alignment
 from ._start import dtw_start, path_warp
+from ._warps import build_warps
 
 
 def align_collection(

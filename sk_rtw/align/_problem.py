@@ -14,17 +14,7 @@ from ._density import density_representatives
 from ._layout import GroupLayout
 from ._loss import window_weights
 from ._sinc import SincInterpolator
-from ._warps import NeuralWarps, SineWarps, WarpModel, compose_warps, unit_time
-
-
-def build_warps(
-    config: AlignmentConfig, layout: GroupLayout, seeds: list[int]
-) -> NeuralWarps | SineWarps:
-    if config.warp == "sine":
-        assert config.n_components is not None  # resolved for TTW
-        return SineWarps(layout, config.n_components)
-    assert config.hidden_size is not None and config.init is not None  # resolved for RTW, NTW
-    return NeuralWarps(layout, config.hidden_size, config.init, config.warp_knots, seeds)
+from ._warps import WarpModel, compose_warps, unit_time
 
 
 class Problem:

@@ -40,6 +40,7 @@ import torch
 from torch import nn
 
 from .._settings import INITS
+from ._config import AlignmentConfig
 from ._layout import GroupLayout
 
 #: Network initialisations: Xavier everywhere (RTW), zeros everywhere (NTW), or Xavier
@@ -384,3 +385,15 @@ class SineWarps(nn.Module):
     @staticmethod
     def finalise(raw: torch.Tensor) -> torch.Tensor:
         return torch.cummax(raw.clamp(0.0, 1.0), dim=-1).values
+
+
+def build_warps(
+    config: AlignmentConfig, layout: GroupLayout, seeds: list[int]
+) -> NeuralWarps | SineWarps:
+    """The warp model a resolved configuration asks for: TTW's sine series, or the
+    networks of RTW and NTW (one per group of ``layout``, seeded by ``seeds``)."""
+    if config.warp == "sine":
+        assert config.n_components is not None  # resolved for TTW
+        return SineWarps(layout, config.n_components)
+    assert config.hidden_size is not None and config.init is not None  # resolved for RTW, NTW
+    return NeuralWarps(layout, config.hidden_size, config.init, config.warp_knots, seeds)
