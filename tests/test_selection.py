@@ -142,8 +142,10 @@ def held_out_reference(X, codes, k, window):
         members = np.flatnonzero(codes == c)
         sub = np.ascontiguousarray(D[np.ix_(members, members)])
         count = int(_selection.class_counts(k, np.array([len(members)]))[0])
-        out[members, c] = reference_held_out(sub, count) if count < len(members) else (
-            np.where(np.eye(len(members), dtype=bool), np.inf, sub).min(1)
+        out[members, c] = (
+            reference_held_out(sub, count)
+            if count < len(members)
+            else (np.where(np.eye(len(members), dtype=bool), np.inf, sub).min(1))
         )
         medoids = members if count >= len(members) else members[kmedoids(sub, count)[0]]
         others = np.flatnonzero(codes != c)
@@ -172,8 +174,9 @@ def test_held_out_scores_match_the_whole_matrix(k, window):
     np.testing.assert_array_equal(nearest.distances.min(1),
                                   np.where(others <= limit, others, np.inf))  # fmt: skip
     for shared in (None, nearest):
-        quick_scores = _selection.held_out_scores(collection, codes, partition, window,
-                                                  every_class=False, nearest_other=shared)
+        quick_scores = _selection.held_out_scores(
+            collection, codes, partition, window, every_class=False, nearest_other=shared
+        )
         np.testing.assert_array_equal(quick_scores.argmin(1), expected.argmin(1))
         np.testing.assert_array_equal(quick_scores[np.arange(23), codes],
                                       expected[np.arange(23), codes])  # fmt: skip
@@ -368,37 +371,3 @@ def test_every_series_a_centroid_is_1nn_within_the_band():
     np.testing.assert_array_equal(clf.predict(X_new), y[nearest])
     one = RTWNearestCentroid(method=quick(), n_centroids=1, dtw_window=0.1).fit(X, y)
     assert len(one.means_) == 2  # the integer 1 is one centroid per class
-
-
-def test_large_classes_are_split_in_chunks(monkeypatch):
-    monkeypatch.setattr(_selection, "PART_SERIES", 7)
-    rng = np.random.default_rng(2)
-    X = rng.standard_normal((30, 15)).cumsum(1)
-    codes = np.repeat([0, 1], [20, 10])
-    groups, owners = _selection.partition(check_series_collection(X), codes, 0.25, 0.1,
-                                          random_state=0)  # fmt: skip
-    np.testing.assert_array_equal(np.bincount(owners), [5, 3])
-    np.testing.assert_array_equal(owners[groups], codes)  # every series in its class
-    assert np.all(np.bincount(groups) >= 1)
-    np.testing.assert_array_equal(_selection._apportion(5, np.array([7, 7, 6])), [2, 2, 1])
-    np.testing.assert_array_equal(_selection._apportion(3, np.array([4, 3, 3])), [1, 1, 1])
-
-
-def test_a_sampled_class_is_split_on_its_completed_matrix(monkeypatch):
-    """The pairs the choice computed are reused: the completed matrix equals the class's
-    whole DTW matrix, so the parts are those of a fresh k-medoids."""
-    monkeypatch.setattr(_selection, "MAX_SERIES", 14)
-    X, y = two_shapes_per_class(n=20)
-    collection = check_series_collection(X)
-    selection = _selection.choose(collection, y, 0.1, 0.25, random_state=0)
-    assert selection.report["sampled"]
-    for c in (0, 1):
-        members = np.flatnonzero(y == c)
-        seen = np.flatnonzero(np.isin(members, selection.sample))
-        completed = _selection._complete(collection, members, (seen, selection.matrices[c]),
-                                         0.1, None)  # fmt: skip
-        whole = dtw_pairwise_distance(X[members], window=0.1)
-        np.testing.assert_allclose(completed, whole, rtol=1e-12)
-    groups, owners = _selection.partition(collection, y, 0.25, 0.1, selection=selection)
-    np.testing.assert_array_equal(np.bincount(owners), [5, 3])
-    np.testing.assert_array_equal(owners[groups], y)

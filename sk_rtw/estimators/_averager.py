@@ -24,7 +24,8 @@ from ._params import (
     set_params_with_hints,
     setting_hint,
 )
-from ._selection import choose, partition
+from ._partition import partition
+from ._selection import choose
 
 if TYPE_CHECKING:
     import torch

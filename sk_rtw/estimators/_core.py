@@ -7,7 +7,7 @@ Class means (:class:`RTWAverager`), several centroids per class and clustering
 * :func:`fit_centroids` -- one centroid per group of a stacked collection, by the
   method's :meth:`~sk_rtw.methods.AveragingMethod.fit_groups` (the engine's methods
   solve all groups in one optimisation; DBA averages group by group). The groups are
-  the classes, or the parts of every class (:func:`~sk_rtw.estimators._selection.partition`);
+  the classes, or the parts of every class (:func:`~sk_rtw.estimators._partition.partition`);
 * :func:`kmeans` -- Lloyd's iterations with manifold DTW for independent clustering
   problems in lockstep (:class:`RTWKMeans`): each round fits the centroids of every
   cluster of every unfinished problem in one :func:`fit_centroids` call.
