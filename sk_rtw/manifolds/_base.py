@@ -19,7 +19,7 @@ import torch
 
 from .._backend import numpy_compatible, safe_norm, to_tensor
 from .._random import check_generator
-from ._mean import MEAN_MAX_ITER, MEAN_TOL, frechet_mean, group_expand
+from ._mean import MEAN_MAX_ITER, MEAN_TOL, checked_mean, group_expand
 
 #: Magnitudes beyond ``10 ** +-EXTREME_EXPONENT`` are aligned in a rescaled frame.
 EXTREME_EXPONENT = 100
@@ -385,7 +385,7 @@ class Manifold(ABC):
         """
         if not isinstance(X, torch.Tensor):
             X = self._check_argument(X, "X", is_point=True)
-        return numpy_compatible(_mean_impl)(
+        return numpy_compatible(checked_mean)(
             self, X, weights, groups, start, axis=axis, max_iter=max_iter, tol=tol
         )
 
@@ -543,78 +543,6 @@ def _first_index(mask: torch.Tensor) -> str:
         return ""
     first = torch.nonzero(mask)[0].tolist()
     return "[" + ", ".join(str(i) for i in first) + "]"
-
-
-def _mean_impl(
-    manifold: Manifold,
-    X: torch.Tensor,
-    weights: torch.Tensor | None,
-    groups: torch.Tensor | None,
-    start: torch.Tensor | None,
-    *,
-    axis: int,
-    max_iter: int,
-    tol: float,
-) -> torch.Tensor:
-    nd = manifold.point_ndim
-    n_leading = X.ndim - nd
-    if n_leading < 1:
-        raise ValueError(
-            f"mean needs at least one sample axis before the point axes {manifold.point_shape}"
-        )
-    axis = axis % n_leading
-    X = torch.movedim(X, axis, 0)
-    n = X.shape[0]
-    if n == 0:
-        raise ValueError(
-            f"cannot compute the mean of zero samples: X has shape {tuple(X.shape)}, with no "
-            f"sample along axis {axis}"
-        )
-    codes = None if groups is None else _check_groups(groups, n, X.device)
-    n_groups = 1 if codes is None else int(codes.max()) + 1
-    if weights is not None:
-        w = weights.to(dtype=X.dtype, device=X.device)
-        if w.ndim == 0 or w.shape[0] != n or w.ndim > n_leading:
-            raise ValueError(
-                f"weights must have {n} entries along the sample axis (shape ({n},) or "
-                f"broadcastable to the leading axes {tuple(X.shape[:n_leading])}), got shape "
-                f"{tuple(w.shape)}"
-            )
-        if not bool(torch.isfinite(w).all()):
-            raise ValueError("weights contain NaN or infinite values")
-        if bool((w < 0).any()):
-            raise ValueError("weights must be non-negative")
-        index = torch.zeros(n, dtype=torch.long) if codes is None else codes
-        totals = w.new_zeros(n_groups, *w.shape[1:]).index_add(0, index.to(w.device), w)
-        if bool((totals <= 0).any()):
-            raise ValueError("weights must not all be zero (in any group)")
-        weights = w
-    if start is not None:
-        start = start.to(dtype=X.dtype, device=X.device)
-        expected = (n_groups, *X.shape[1:])
-        if groups is None:
-            start = start.unsqueeze(0)
-        if tuple(start.shape) != expected:
-            raise ValueError(
-                f"start must have shape {expected[1:] if groups is None else expected}, got "
-                f"{tuple(start.shape)[1 if groups is None else 0 :]}"
-            )
-    mean = frechet_mean(manifold, X, weights, codes, start=start, max_iter=max_iter, tol=tol)
-    return mean if groups is not None else mean[0]
-
-
-def _check_groups(groups: torch.Tensor, n: int, device) -> torch.Tensor:
-    if groups.dtype.is_floating_point and not bool((groups == groups.round()).all()):
-        raise ValueError("groups must be integers, one per sample")
-    codes = groups.to(device=device, dtype=torch.long).reshape(-1)
-    if codes.numel() != n:
-        raise ValueError(f"groups must have one entry per sample ({n}), got {codes.numel()}")
-    if bool((codes < 0).any()):
-        raise ValueError("groups must be non-negative integers")
-    empty = torch.bincount(codes) == 0
-    if bool(empty.any()):
-        raise ValueError(f"groups {torch.nonzero(empty).flatten().tolist()} have no sample")
-    return codes
 
 
 def power_of_two_scale(magnitude: float) -> float | None:
