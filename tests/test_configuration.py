@@ -18,7 +18,8 @@ from sk_rtw._settings._resolve import _cell
 from sk_rtw.align import KNOBS, PRESETS
 from sk_rtw.baselines import dba_average
 from sk_rtw.methods import METHODS, AveragingMethod, EngineMethod
-from sk_rtw.utils._params import Interval, Parameter, declare_parameters
+from sk_rtw.utils._constraints import Interval
+from sk_rtw.utils._params import Parameter, declare_parameters
 
 METHODS_PAGE = Path(__file__).resolve().parents[1] / "docs" / "user_guide" / "methods.md"
 ESTIMATORS = [
@@ -73,9 +74,7 @@ def test_an_unknown_keyword_still_says_where_the_setting_belongs():
 
 
 def test_dba_average_defaults_are_the_dba_knobs():
-    defaults = {
-        name: p.default for name, p in inspect.signature(dba_average).parameters.items()
-    }
+    defaults = {name: p.default for name, p in inspect.signature(dba_average).parameters.items()}
     for knob in ("max_iter", "tol"):
         assert defaults[knob] == KNOBS[knob].defaults["dba"], knob
 

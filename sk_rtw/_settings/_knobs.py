@@ -14,7 +14,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from ..utils._params import Boolean, Constant, Interval, Options, Parameter
+from ..utils._constraints import Boolean, Constant, Interval, Options
+from ..utils._params import Parameter
 
 #: Where the DTW start's warps are measured (``start_axis``).
 START_AXES = ("average", "reference")

@@ -16,7 +16,8 @@ from typing import Any
 
 import torch
 
-from ..utils._params import AUTO, InstanceOf, Options, Parameter
+from ..utils._constraints import AUTO, InstanceOf, Options
+from ..utils._params import Parameter
 from ._knobs import ENGINE_METHODS, KNOBS, method_knobs, owners
 from ._presets import PRESETS
 
@@ -161,9 +162,7 @@ def presets_markdown() -> str:
             elif len(values) == 1 and set(changed) == set(knob.methods) - {"dba"}:
                 cells.append(values.pop())
             else:
-                cells.append(
-                    ", ".join(f"{m.upper()}: {_cell(v)}" for m, v in changed.items())
-                )
+                cells.append(", ".join(f"{m.upper()}: {_cell(v)}" for m, v in changed.items()))
         lines.append("| " + " | ".join([f"`{name}`", *cells]) + " |")
     return "\n".join(lines)
 

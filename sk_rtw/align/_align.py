@@ -21,14 +21,8 @@ from .._settings import (
 from ..manifolds import Manifold
 from ..utils import SeriesCollection, check_series_collection
 from ..utils._common_params import DTW_WINDOW, MANIFOLD, N_JOBS, RANDOM_STATE, VERBOSE
-from ..utils._params import (
-    Declaration,
-    Options,
-    Parameter,
-    Satisfies,
-    check_signature_defaults,
-    drop_auto,
-)
+from ..utils._constraints import Options, Satisfies
+from ..utils._params import Declaration, Parameter, check_signature_defaults, drop_auto
 from ._config import resolve_config, size_config
 from ._fit import align_collection
 from ._result import Alignment

@@ -12,7 +12,8 @@ from ..dtw import check_window, coarse_collection, medoid_index, path_indices
 from ..manifolds import Manifold
 from ..manifolds._mean import frechet_mean
 from ..utils import check_series_collection
-from ..utils._params import Interval, Parameter
+from ..utils._constraints import Interval
+from ..utils._params import Parameter
 from ._result import MultipleAlignment, make_result
 
 #: Gauss–Newton steps of each per-sample Fréchet mean in one DBA iteration.

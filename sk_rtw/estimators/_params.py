@@ -13,7 +13,8 @@ from .._settings import DEVICE_PARAMETER, PRESET_PARAMETER, owners, settings_tab
 from ..methods._registry import METHODS, method_parameter
 from ..utils._common_params import DTW_WINDOW as BAND
 from ..utils._common_params import MANIFOLD, N_JOBS, RANDOM_STATE, VERBOSE
-from ..utils._params import Interval, Options, Parameter, doc_indent, indent, wrap
+from ..utils._constraints import Interval, Options
+from ..utils._params import Parameter, doc_indent, indent, wrap
 
 METHOD = method_parameter(
     'Averaging method: "rtw", "ttw", "ntw", "dba" (DTW barycenter averaging with Fréchet '
@@ -38,7 +39,7 @@ DTW_WINDOW = replace(
     BAND.with_auto(),
     doc="Sakoe-Chiba band of every DTW of the fit (the DTW start of RTW, TTW and NTW, DBA, "
     "the partition into centroids) and of prediction, its radius as a fraction of the "
-    'shorter series\' length; None: no band. "auto": the preset\'s value: chosen from the '
+    "shorter series' length; None: no band. \"auto\": the preset's value: chosen from the "
     'training data with the centroids (fitted ``dtw_window_``) under "class-means" and '
     '"alignment", no band under "paper".',
 )
@@ -134,7 +135,7 @@ def settings_notes(method: str, preset: str, chooses: bool = False) -> str:
         f'What runs by default: ``method="{method}"``, i.e. :class:`~sk_rtw.{label}` with '
         f'every setting ``"auto"``: the value of the preset (``preset="{preset}"`` unless '
         f"set), listed below; a value given in the method object, "
-        f"``method={label}(n_epochs=64)``, replaces it. ``\"auto\"`` means the preset's "
+        f'``method={label}(n_epochs=64)``, replaces it. ``"auto"`` means the preset\'s '
         "value everywhere in the package."
     ]
     if chooses:

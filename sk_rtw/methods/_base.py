@@ -24,7 +24,8 @@ from sklearn.base import BaseEstimator
 from .._settings import ENGINE_METHODS, method_knobs, owners
 from ..manifolds import Manifold
 from ..utils import SeriesCollection
-from ..utils._params import AUTO, validate_parameters
+from ..utils._constraints import AUTO
+from ..utils._params import validate_parameters
 
 
 @runtime_checkable

@@ -11,15 +11,14 @@ from typing import Any
 
 from sklearn.base import clone
 
-from ..utils._params import InstanceOf, Parameter, Satisfies
+from ..utils._constraints import InstanceOf, Satisfies
+from ..utils._params import Parameter
 from ._base import AveragingMethod
 from ._dba import DBA
 from ._engine import NTW, RTW, TTW
 
 #: Every averaging method shipped, by name.
-METHODS: dict[str, type[AveragingMethod]] = {
-    cls.name: cls for cls in (RTW, TTW, NTW, DBA)
-}
+METHODS: dict[str, type[AveragingMethod]] = {cls.name: cls for cls in (RTW, TTW, NTW, DBA)}
 
 
 def _known_name(value: Any) -> bool:

@@ -8,7 +8,8 @@ from typing import Any
 import numpy as np
 
 from ..manifolds import Manifold
-from ._params import Boolean, Constant, InstanceOf, Interval, Parameter, Satisfies
+from ._constraints import Boolean, Constant, InstanceOf, Interval, Satisfies
+from ._params import Parameter
 
 
 def _seed_like(value: Any) -> bool:
