@@ -18,6 +18,7 @@ from .estimators import (
     RTWAverager,
     RTWKMeans,
     RTWNearestCentroid,
+    RTWPrototypeClassifier,
     TTWAverager,
     TTWNearestCentroid,
 )
@@ -55,6 +56,7 @@ __all__ = [
     "RTWAverager",
     "RTWKMeans",
     "RTWNearestCentroid",
+    "RTWPrototypeClassifier",
     "Sphere",
     "TTWAverager",
     "TTWNearestCentroid",

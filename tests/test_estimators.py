@@ -22,6 +22,7 @@ from sk_rtw import (
     NTWNearestCentroid,
     RTWAverager,
     RTWNearestCentroid,
+    RTWPrototypeClassifier,
     TTWAverager,
     TTWNearestCentroid,
 )
@@ -40,7 +41,12 @@ ESTIMATORS = [
         (TTWNearestCentroid, "ttw"),
         (NTWNearestCentroid, "ntw"),
     )
-] + [RTWNearestCentroid(method="dba"), RTWAverager(method="dba")]
+] + [
+    RTWNearestCentroid(method="dba"),
+    RTWAverager(method="dba"),
+    RTWPrototypeClassifier(method="dba", cv=3),
+    RTWPrototypeClassifier(method=quick(), decision="readout", cv=2, random_state=0),
+]
 
 # Each expected failure of scikit-learn's generic checks, with the reason. Series of any
 # length are accepted at predict/transform time (DTW compares series of different

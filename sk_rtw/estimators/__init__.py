@@ -1,8 +1,10 @@
-"""scikit-learn estimators: class means by time warping, nearest-centroid classifiers."""
+"""scikit-learn estimators: class means by time warping, nearest-centroid and prototype
+classifiers."""
 
 from ._averager import NTWAverager, RTWAverager, TTWAverager
 from ._classifier import NTWNearestCentroid, RTWNearestCentroid, TTWNearestCentroid
 from ._kmeans import RTWKMeans
+from ._prototypes import RTWPrototypeClassifier
 
 __all__ = [
     "NTWAverager",
@@ -10,6 +12,7 @@ __all__ = [
     "RTWAverager",
     "RTWKMeans",
     "RTWNearestCentroid",
+    "RTWPrototypeClassifier",
     "TTWAverager",
     "TTWNearestCentroid",
 ]

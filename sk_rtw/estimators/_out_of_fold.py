@@ -1,0 +1,145 @@
+"""Distances of the training series to centroids that did not see them (out-of-fold).
+
+A readout trained on the distances of the training series to the fitted centroids learns
+from values that never occur at prediction time: a series is close to the centroid it
+was averaged into. Here the training series are split into stratified folds; for every
+fold, each centroid that averaged some of the fold's series is refitted on its other
+series (same method, band, seed and settings; every touched centroid of the fold in one
+batched fit), and the fold's series are measured against the centroids of the fit with
+the refitted ones in their place. A centroid is only refitted without the series of its
+own part, so the columns keep their meaning: column ``m`` is always "centroid ``m``".
+
+A centroid whose every series lies in the fold (a centroid of one series) cannot be
+refitted without them; its distance to those series is what the other series of their
+class measure to it (their mean, which is out of sample for such a centroid), and the
+fold's other series are measured against it as fitted.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+import warnings
+from typing import Any
+
+import numpy as np
+from sklearn.model_selection import KFold, StratifiedKFold
+from sklearn.utils import check_random_state
+
+from ..dtw import dtw_pairwise_distance
+from ..methods import FitContext, get_method
+from ..utils import SeriesCollection, check_series_collection
+from ..utils._params import validate_parameters
+from ._core import fit_centroids
+
+
+def out_of_fold_distances(
+    centroids: Any,
+    collection: SeriesCollection,
+    codes: np.ndarray,
+    n_folds: int,
+    *,
+    random_state: Any = None,
+    owner: str = "RTWPrototypeClassifier",
+) -> np.ndarray:
+    """Distance of every training series to every centroid, out of fold.
+
+    Parameters
+    ----------
+    centroids : RTWNearestCentroid
+        Fitted on ``collection`` (its ``assignments_``, ``centroid_classes_``, ``means_``,
+        ``dtw_window_`` and method settings are reused).
+    collection : SeriesCollection
+        The training series of the fit.
+    codes : ndarray of int, shape (n_series,)
+        Class index of every series.
+    n_folds : int
+        Stratified folds (at most the size of the largest class).
+    random_state : int, RandomState or None
+        Draws the folds and the refits' seeds, as the fit drew its seeds.
+    owner : str
+        The estimator's name, for the ``verbose`` lines.
+
+    Returns
+    -------
+    distances : ndarray of shape (n_series, n_means)
+        Column ``m`` is the entry ``m`` of ``centroids.means_``.
+    """
+    params = validate_parameters(centroids)
+    method = get_method(params["method"])
+    verbose = int(params["verbose"])
+    context = FitContext(
+        preset=params["preset"], device=params["device"], n_jobs=params["n_jobs"],
+        verbose=max(0, verbose - 1), dtw_window=centroids.dtw_window_,
+    )  # fmt: skip
+    config = method.configure(context)
+    groups = np.asarray(centroids.assignments_, dtype=np.int64)
+    n_means = len(centroids.centroid_classes_)
+    means = list(centroids.means_)
+    # the seeds the fit gave every centroid (RTWAverager._fit_means draws them so)
+    seeds = check_random_state(centroids.random_state).randint(2**31 - 1, size=n_means)
+    rng = check_random_state(random_state)
+    splitter = fold_splitter(n_folds, codes, rng.randint(2**31 - 1))
+    distances = np.full((collection.n_series, n_means), np.nan)
+    start = time.perf_counter()
+    with warnings.catch_warnings():  # a class smaller than the folds: some folds miss it
+        warnings.filterwarnings("ignore", "The least populated class", UserWarning)
+        folds = [test for _, test in splitter.split(np.zeros(len(codes)), codes)]
+    for k, test in enumerate(folds):
+        in_fold = np.zeros(collection.n_series, dtype=bool)
+        in_fold[test] = True
+        touched = np.unique(groups[test])
+        kept = [m for m in touched if np.any((groups == m) & ~in_fold)]
+        fold_means = list(means)
+        if kept:
+            rows = np.flatnonzero(np.isin(groups, kept) & ~in_fold)
+            refit_codes = np.searchsorted(kept, groups[rows])
+            fits = fit_centroids(
+                method, config, collection.subset(rows), refit_codes,
+                [int(seeds[m]) for m in kept], context, kind="centroid", owner=owner,
+            )  # fmt: skip
+            for m, fit in zip(kept, fits, strict=True):
+                fold_means[m] = fit.mean
+        reference = check_series_collection(fold_means, collection.manifold, name="means_")
+        distances[test] = dtw_pairwise_distance(
+            collection.subset(test), reference, window=centroids.dtw_window_,
+            n_jobs=params["n_jobs"],
+        )  # fmt: skip
+        # a centroid whose every series is in the fold has not been seen without them
+        lost = np.setdiff1d(touched, kept)
+        own = np.isin(groups[test], lost)
+        distances[test[own], groups[test[own]]] = np.nan
+        if verbose:
+            print(
+                f"[{owner}] fold {k + 1}/{len(folds)}: {len(kept)} of {n_means} centroids "
+                f"refitted without its {len(test)} series "
+                f"({time.perf_counter() - start:.1f} s)",
+                file=sys.stderr,
+                flush=True,
+            )
+    return _fill_unseen(distances, codes)
+
+
+def fold_splitter(n_folds: int, codes: np.ndarray, seed: int) -> KFold | StratifiedKFold:
+    """Stratified folds, at most as many as the largest class has series (plain folds
+    where every class holds one series)."""
+    largest = int(np.bincount(codes).max())
+    if largest < 2:
+        return KFold(min(n_folds, len(codes)), shuffle=True, random_state=seed)
+    return StratifiedKFold(min(n_folds, largest), shuffle=True, random_state=seed)
+
+
+def _fill_unseen(distances: np.ndarray, codes: np.ndarray) -> np.ndarray:
+    """Each missing distance (a series to a centroid made of it alone) becomes the mean
+    distance of the other series of its class to that centroid (of every series where
+    the class has no other)."""
+    missing = np.isnan(distances)
+    if not missing.any():
+        return distances
+    filled = distances.copy()
+    for i, m in zip(*np.nonzero(missing), strict=True):
+        column = distances[:, m]
+        same = column[(codes == codes[i]) & ~np.isnan(column)]
+        pool = same if len(same) else column[~np.isnan(column)]
+        filled[i, m] = pool.mean() if len(pool) else 0.0
+    return filled
