@@ -125,7 +125,7 @@ def test_auto_decision_follows_the_cross_validated_scores():
     at least one standard error above it; the scores are recomputed here."""
     from sklearn.base import clone as clone_estimator
 
-    from sk_rtw.estimators._out_of_fold import fold_splitter
+    from sk_rtw.estimators._out_of_fold import split_folds
     from sk_rtw.estimators._prototypes import default_readout
 
     X, y = three_shape_classes(n_per_class=10, seed=1)
@@ -134,7 +134,7 @@ def test_auto_decision_follows_the_cross_validated_scores():
     features = np.log1p(clf.oof_distances_ / clf.distance_scale_)
     seed = np.random.RandomState(0).randint(2**31 - 1)
     predicted = np.empty(len(y), dtype=int)
-    for train, test in fold_splitter(3, y, seed).split(features, y):
+    for train, test in split_folds(3, y, seed):
         predicted[test] = (
             clone_estimator(default_readout())
             .fit(features[train], y[train])

@@ -79,12 +79,9 @@ def out_of_fold_distances(
     # the seeds the fit gave every centroid (RTWAverager._fit_means draws them so)
     seeds = check_random_state(centroids.random_state).randint(2**31 - 1, size=n_means)
     rng = check_random_state(random_state)
-    splitter = fold_splitter(n_folds, codes, rng.randint(2**31 - 1))
     distances = np.full((collection.n_series, n_means), np.nan)
     start = time.perf_counter()
-    with warnings.catch_warnings():  # a class smaller than the folds: some folds miss it
-        warnings.filterwarnings("ignore", "The least populated class", UserWarning)
-        folds = [test for _, test in splitter.split(np.zeros(len(codes)), codes)]
+    folds = [test for _, test in split_folds(n_folds, codes, rng.randint(2**31 - 1))]
     for k, test in enumerate(folds):
         in_fold = np.zeros(collection.n_series, dtype=bool)
         in_fold[test] = True
@@ -120,13 +117,19 @@ def out_of_fold_distances(
     return _fill_unseen(distances, codes)
 
 
-def fold_splitter(n_folds: int, codes: np.ndarray, seed: int) -> KFold | StratifiedKFold:
-    """Stratified folds, at most as many as the largest class has series (plain folds
-    where every class holds one series)."""
+def split_folds(n_folds: int, codes: np.ndarray, seed: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Stratified (train, test) folds, at most as many as the largest class has series
+    (plain folds where every class holds one series); a class smaller than the folds is
+    missing from some of them."""
     largest = int(np.bincount(codes).max())
+    splitter: KFold | StratifiedKFold
     if largest < 2:
-        return KFold(min(n_folds, len(codes)), shuffle=True, random_state=seed)
-    return StratifiedKFold(min(n_folds, largest), shuffle=True, random_state=seed)
+        splitter = KFold(min(n_folds, len(codes)), shuffle=True, random_state=seed)
+    else:
+        splitter = StratifiedKFold(min(n_folds, largest), shuffle=True, random_state=seed)
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", "The least populated class", UserWarning)
+        return list(splitter.split(np.zeros(len(codes)), codes))
 
 
 def _fill_unseen(distances: np.ndarray, codes: np.ndarray) -> np.ndarray:

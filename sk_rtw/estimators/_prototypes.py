@@ -18,7 +18,7 @@ from ..utils._constraints import Constant, Interval, Options, Satisfies
 from ..utils._params import Parameter, declare_parameters, validate_parameters
 from ._averager import _check_labels, _encode
 from ._classifier import RTWNearestCentroid, fit_temperature
-from ._out_of_fold import fold_splitter, out_of_fold_distances
+from ._out_of_fold import out_of_fold_distances, split_folds
 from ._params import (
     AVERAGER_DEFAULTS,
     AVERAGER_PARAMETERS,
@@ -134,10 +134,11 @@ class RTWPrototypeClassifier(ClassifierMixin, TransformerMixin, BaseEstimator):
     ``readout`` takes any scikit-learn classifier (``LogisticRegression`` for
     probabilities); ``decision="auto"`` keeps the nearest centroid where the readout
     does not clearly classify the training series better, cross-validated
-    (``decision_``), and ``decision="readout"`` always uses the readout. Why out of fold: a series' distance to a centroid averaged from it is
-    small, and a readout trained on such distances learns from values that never occur
-    at prediction time. The UCR benchmark page gives the accuracy, fit and prediction
-    times measured against nearest centroid, 1-NN DTW and MiniRocket.
+    (``decision_``), and ``decision="readout"`` always uses the readout. Why out of
+    fold: a series' distance to a centroid averaged from it is small, and a readout
+    trained on such distances learns from values that never occur at prediction time.
+    The UCR benchmark page gives the accuracy, fit and prediction times measured against
+    nearest centroid, 1-NN DTW and MiniRocket.
 
     Parameters
     ----------
@@ -297,7 +298,7 @@ class RTWPrototypeClassifier(ClassifierMixin, TransformerMixin, BaseEstimator):
             return decision, {}
         seed = check_random_state(self.random_state).randint(2**31 - 1)
         predicted = np.empty_like(codes)
-        for train, test in fold_splitter(n_folds, codes, seed).split(features, codes):
+        for train, test in split_folds(n_folds, codes, seed):
             if len(np.unique(codes[train])) < 2:  # a fold without a second class
                 predicted[test] = codes[train][0]
                 continue
