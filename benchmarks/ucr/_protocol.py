@@ -12,8 +12,12 @@ For one dataset and each method:
    ``rtw-default``, ``dba-default``, ``ttw-default``, ``ntw-default`` are the classifier a
    user gets by default (``RTWNearestCentroid(method=...)``: the band and the centroids
    per class chosen from the training data, every centroid averaged with the method);
-   ``aeon-dba`` is aeon's ``elastic_barycenter_average`` with DTW (a reference where the
-   data are Euclidean);
+   ``rtw-prototype`` and ``dba-prototype`` are :class:`sk_rtw.RTWPrototypeClassifier`
+   with that method (the default classifier's centroids, out-of-fold distances to every
+   centroid and a linear readout); ``aeon-dba`` is aeon's ``elastic_barycenter_average``
+   with DTW (a reference where the data are Euclidean); ``minirocket`` is aeon's
+   ``MiniRocketClassifier`` (the field's default classifier; unequal-length series are
+   linearly resampled to the longest training length first, which it needs);
 2. averaging values, per training series: ``alignment`` = DTW of the *warped* (aligned)
    series to its class mean (the paper's averaging score; not for aeon's DBA) and
    ``barycenter`` = DTW of the unwarped series to its class mean;
@@ -52,12 +56,18 @@ from pathlib import Path
 import numpy as np
 from scipy import stats
 
-from sk_rtw import Alignment, RTWNearestCentroid, dtw_nearest_distance, dtw_pairwise_distance
+from sk_rtw import (
+    Alignment,
+    RTWNearestCentroid,
+    RTWPrototypeClassifier,
+    dtw_nearest_distance,
+    dtw_pairwise_distance,
+)
 from sk_rtw.estimators._selection import WINDOWS
 from sk_rtw.utils import to_aeon
 
 from .._shared import method_object
-from ._data import load_split, subsample_per_class, take
+from ._data import Split, load_split, subsample_per_class, take
 
 ALPHA = 0.05
 #: Result files are readable by everyone (rw-r--r--), like any file the user writes.
@@ -84,17 +94,26 @@ ESTIMATOR_METHODS: dict[str, tuple[str, dict, str, dict]] = {
     "dba-default": ("dba", {}, "class-means", {}),
     "ttw-default": ("ttw", {}, "class-means", {}),
     "ntw-default": ("ntw", {}, "class-means", {}),
+    # RTWPrototypeClassifier: the default classifier's centroids read out linearly
+    "rtw-prototype": ("rtw", {}, "class-means", {}),
+    "dba-prototype": ("dba", {}, "class-means", {}),
 }
 #: Rows of the classifier a user gets by default.
 DEFAULT_CLASSIFIERS = tuple(m for m in ESTIMATOR_METHODS if m.endswith("-default"))
-REFERENCE_METHODS = ("aeon-dba", "1nn-dtw", "1nn-dtw-band")
+#: Rows of RTWPrototypeClassifier.
+PROTOTYPE_CLASSIFIERS = tuple(m for m in ESTIMATOR_METHODS if m.endswith("-prototype"))
+REFERENCE_METHODS = ("aeon-dba", "1nn-dtw", "1nn-dtw-band", "minirocket")
 #: Rows that do not depend on the seed: ``--resume`` keeps them when only the seed changed.
 SEED_FREE = ("1nn-dtw", "1nn-dtw-band")
 ALL_METHODS = (*ESTIMATOR_METHODS, *REFERENCE_METHODS)
-#: The main job's rows: the paper's one-mean comparison, the default classifier and the
-#: references (``rtw-paper`` is slow: means of length N T with the network at every time
-#: point; the ablations and the other default classifiers on demand, with ``--methods``).
-DEFAULT_METHODS = ("rtw", "ttw", "ntw", "dba", "rtw-default", "aeon-dba", "1nn-dtw")
+#: The main job's rows: the paper's one-mean comparison, the default classifier, the
+#: prototype classifier and the references (``rtw-paper`` is slow: means of length N T
+#: with the network at every time point; the ablations and the other default and
+#: prototype classifiers on demand, with ``--methods``).
+DEFAULT_METHODS = (
+    "rtw", "ttw", "ntw", "dba", "rtw-default", "rtw-prototype", "aeon-dba", "1nn-dtw",
+    "minirocket",
+)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -133,12 +152,13 @@ def _class_members(y, classes):
     return [np.flatnonzero(y == c) for c in classes]
 
 
-def make_estimator(row: str, config: RunConfig) -> RTWNearestCentroid:
+def make_estimator(row: str, config: RunConfig) -> RTWNearestCentroid | RTWPrototypeClassifier:
     """The estimator of one row, with the run's epochs, output length, seed and device."""
     name, settings, preset, params = ESTIMATOR_METHODS[row]
     lengths = {} if config.output_length is None else {"output_length": config.output_length}
     method = method_object(name, **settings, n_epochs=config.epochs, **lengths)
-    return RTWNearestCentroid(
+    estimator = RTWPrototypeClassifier if row in PROTOTYPE_CLASSIFIERS else RTWNearestCentroid
+    return estimator(
         method=method,
         preset=preset,
         random_state=config.seed,
@@ -154,6 +174,10 @@ def _fit_estimator(method, train, test, config):
     start = time.perf_counter()
     estimator.fit(train.X, train.y)
     fit_seconds = time.perf_counter() - start
+    prototype = isinstance(estimator, RTWPrototypeClassifier)
+    readout = estimator
+    if prototype:  # the centroids are its nearest-centroid fit's
+        estimator = estimator.centroids_
     alignment = np.full(len(train.y), np.nan)
     barycenter = np.full(len(train.y), np.nan)
     for k, fitted in enumerate(estimator.alignments_):  # every centroid and its series
@@ -165,11 +189,23 @@ def _fit_estimator(method, train, test, config):
         )
         barycenter[members] = dtw_pairwise_distance(series, mean)[:, 0]
     start = time.perf_counter()
-    distances = estimator.class_distances(test.X)
-    predictions = estimator.classes_[distances.argmin(1)]
+    if prototype:
+        predictions, distances = readout.predict(test.X), None
+    else:
+        distances = estimator.class_distances(test.X)
+        predictions = estimator.classes_[distances.argmin(1)]
+    predict_seconds = time.perf_counter() - start
+    extra = {}
+    if prototype:
+        nearest = estimator.predict(test.X)  # untimed: the nearest-centroid decision
+        extra = {
+            "decision": readout.decision_,
+            "cv_accuracy": readout.cv_accuracy_,
+            "nearest_accuracy": float(np.mean(nearest == test.y)),
+        }
     return {
         "fit_seconds": fit_seconds,
-        "predict_seconds": time.perf_counter() - start,
+        "predict_seconds": predict_seconds,
         "alignment": alignment,
         "barycenter": barycenter,
         "predictions": predictions,
@@ -183,6 +219,7 @@ def _fit_estimator(method, train, test, config):
         "selection": estimator.selection_,
         "iterations": [a.n_iter for a in estimator.alignments_],
         "output_length": [len(m) for m in estimator.means_],
+        **extra,
     }
 
 
@@ -226,6 +263,41 @@ def _fit_1nn(train, test, config):
     fit_seconds = time.perf_counter() - start
     start = time.perf_counter()
     predictions = classifier.predict(to_aeon(test.X))
+    return {
+        "fit_seconds": fit_seconds,
+        "predict_seconds": time.perf_counter() - start,
+        "predictions": predictions,
+        "classes": classifier.classes_,
+    }
+
+
+def equal_length(X, length: int) -> np.ndarray:
+    """Series linearly resampled to ``length`` samples (a stack as they are if equal)."""
+    if isinstance(X, np.ndarray) and X.shape[1] == length:
+        return X
+    out = []
+    for series in X:
+        series = np.asarray(series, dtype=float).reshape(len(series), -1)
+        old, new = np.linspace(0.0, 1.0, len(series)), np.linspace(0.0, 1.0, length)
+        out.append(np.stack([np.interp(new, old, c) for c in series.T], axis=1))
+    return np.stack(out)
+
+
+def _fit_minirocket(train, test, config):
+    """aeon's MiniRocketClassifier (ridge readout over 10,000 random convolution features)."""
+    try:
+        from aeon.classification.convolution_based import MiniRocketClassifier
+    except ImportError as exc:  # pragma: no cover - the benchmark needs aeon for its data
+        raise ImportError(
+            "the minirocket row needs aeon (pip install 'sk-rtw[benchmarks]')"
+        ) from exc
+    length = int(train.lengths.max())
+    classifier = MiniRocketClassifier(random_state=config.seed, n_jobs=1)
+    start = time.perf_counter()
+    classifier.fit(to_aeon(equal_length(train.X, length)), train.y)
+    fit_seconds = time.perf_counter() - start
+    start = time.perf_counter()
+    predictions = classifier.predict(to_aeon(equal_length(test.X, length)))
     return {
         "fit_seconds": fit_seconds,
         "predict_seconds": time.perf_counter() - start,
@@ -331,6 +403,10 @@ def warm_up(methods) -> None:
         if method in ESTIMATOR_METHODS and method not in _WARM:
             make_estimator(method, RunConfig(epochs=2, verbose=0)).fit(X, y).predict(X)
             _WARM.add(method)
+        if method == "minirocket" and method not in _WARM:  # numba compiles its kernels
+            split = Split(X=X, y=np.asarray(y), lengths=np.full(len(X), X.shape[1]))
+            _fit_minirocket(split, split, RunConfig(verbose=0))
+            _WARM.add(method)
 
 
 #: The run settings an estimator row's result depends on (a seed-free row: only the
@@ -408,6 +484,8 @@ def _process_dataset(name, config, position, on_method_done) -> dict:
                     out = _fit_1nn(train, test, config)
                 elif method == "1nn-dtw-band":
                     out = _fit_1nn_band(train, test, config)
+                elif method == "minirocket":
+                    out = _fit_minirocket(train, test, config)
                 else:
                     raise ValueError(f"unknown method {method!r}")
             except Exception as exc:  # one method failing must not lose the others

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 from scipy.stats import rankdata
 
-from ._protocol import DEFAULT_CLASSIFIERS, pairwise_tests
+from ._protocol import DEFAULT_CLASSIFIERS, PROTOTYPE_CLASSIFIERS, pairwise_tests
 
 PAIRS = (
     ("ttw", "rtw"),
@@ -121,12 +121,50 @@ def verdict(records: list[dict], methods: list[str]) -> list[str]:
                     f"{row['losses']} losses on {row['n']} dataset(s)."
                 )
     lines += default_classifier_verdict(records, methods)
+    lines += prototype_verdict(records, methods)
     if len(names) < 30:
         lines.append(
             f"Few datasets ({len(names)}): one dataset moves a share by "
             f"{100 / len(names):.1f} points; read the tables as anecdotes, not rankings."
         )
     return lines
+
+
+def prototype_verdict(records: list[dict], methods: list[str]) -> list[str]:
+    """RTWPrototypeClassifier against the default nearest centroid, 1-NN DTW and MiniRocket,
+    on the datasets where all of them ran."""
+    row = "rtw-prototype"
+    others = [m for m in ("rtw-default", "1nn-dtw", "minirocket") if m in methods]
+    if row not in methods or not others:
+        return []
+    names, acc = accuracy_matrix(records, [row, *others])
+    if not len(names):
+        return []
+    chosen = [r for r in records if r["dataset"] in names]
+    against = "; ".join(
+        f"{other} {acc[:, i + 1].mean():.4f} (gap {acc[:, 0].mean() - acc[:, i + 1].mean():+.4f}"
+        f", at least as accurate on {int(np.sum(acc[:, 0] >= acc[:, i + 1] - 1e-12))})"
+        for i, other in enumerate(others)
+    )
+    decisions = [r["methods"][row].get("decision") for r in chosen]
+    line = (
+        f"The prototype classifier, RTWPrototypeClassifier(): mean accuracy "
+        f"{acc[:, 0].mean():.4f} on {len(names)} dataset(s), against {against}; the readout "
+        f"decided on {decisions.count('readout')} of them, the nearest centroid on the rest"
+    )
+    if "rtw-default" in others:
+        fit = sum(r["methods"][row]["fit_seconds"] for r in chosen)
+        base = sum(r["methods"]["rtw-default"]["fit_seconds"] for r in chosen)
+        predict = sum(r["methods"][row]["predict_seconds"] for r in chosen)
+        base_predict = sum(r["methods"]["rtw-default"]["predict_seconds"] for r in chosen)
+        line += (
+            f"; fit {fit:.1f} s against the nearest centroid's {base:.1f} s "
+            f"({fit / max(base, 1e-9):.2f}x), prediction {predict:.2f} s against "
+            f"{base_predict:.2f} s ({predict / max(base_predict, 1e-9):.2f}x)"
+        )
+    if "minirocket" not in methods:
+        line += " (MiniRocket not run: add --methods minirocket, which needs aeon)"
+    return [line + "."]
 
 
 def timing(records: list[dict], method: str, reference: str = "1nn-dtw") -> dict:
@@ -311,7 +349,7 @@ def halves_markdown(records: list[dict], methods: list[str]) -> list[str]:
         speed = f"{np.median(ratios):.1f}x" if ratios and m != "1nn-dtw" else "-"
         picks = [(e.get("dtw_window"), e.get("n_centroids")) for e in entries]
         chosen = "-"
-        if m in DEFAULT_CLASSIFIERS or m == "1nn-dtw-band":
+        if m in DEFAULT_CLASSIFIERS or m in PROTOTYPE_CLASSIFIERS or m == "1nn-dtw-band":
             counts = {pick: picks.count(pick) for pick in sorted(set(picks), key=str)}
             chosen = "; ".join(
                 f"w={w}" + ("" if k is None else f", k={k}") + f": {n}"
@@ -326,6 +364,11 @@ HALF_PAIRS = (
     ("rtw", "dba"),
     ("rtw-refined", "dba"),
     ("rtw-default", "dba-default"),
+    ("rtw-prototype", "rtw-default"),
+    ("dba-prototype", "dba-default"),
+    ("rtw-prototype", "1nn-dtw"),
+    ("rtw-prototype", "minirocket"),
+    ("rtw-default", "minirocket"),
     ("rtw-default", "1nn-dtw"),
     ("dba-default", "1nn-dtw"),
     ("rtw-default", "1nn-dtw-band"),
