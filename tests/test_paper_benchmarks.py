@@ -251,3 +251,24 @@ def test_the_spd_speed_benchmark_counts_eigendecompositions(capsys):
     assert "eigh " in rows[0] and "million matrices" in rows[0]
     assert "eigh " not in rows[1]  # SPD(2) has closed forms: no eigendecomposition
     assert torch.linalg.eigh is eigh and torch.get_num_threads() == threads
+
+
+def test_manifold_classification_runs_one_fold(tmp_path):
+    """R-LASA, one fold, a coarse step: every row scores, the page is written."""
+    from benchmarks import manifold_classification
+    from benchmarks.paper._data import data_dir
+
+    try:
+        data_dir()
+    except FileNotFoundError:
+        pytest.skip("the shared demonstration data is not next to the repository")
+    page = tmp_path / "page.md"
+    argv = ["--spaces", "quaternion", "spd", "--folds", "0", "--step", "50", "--method",
+            "dba", "--rows", "prototype", "nearest-centroid", "1nn-dtw", "--markdown",
+            str(page), "--quiet"]  # fmt: skip
+    assert manifold_classification.main(argv) == 0
+    text = page.read_text()
+    for row in ("prototype", "nearest-centroid", "1nn-dtw"):
+        assert f"| quaternion | {row}" in text and f"| spd | {row}" in text
+    coords = manifold_classification.coordinates(np.ones((2, 3, 2, 2)), "spd")
+    assert coords.shape == (2, 3, 3)  # (n, channels, T): the three distinct entries

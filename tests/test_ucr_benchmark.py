@@ -423,3 +423,34 @@ def test_the_seeds_report_gives_every_target_per_half_and_seed(tmp_path, capsys)
     row = next(line for line in printed.splitlines() if line.startswith("| mean accuracy, def"))
     assert row.split(" | ")[1].startswith(default)  # half A holds GunPoint
     assert "| the same choice on every seed (datasets) | 1 of 1 | 1 of 1 | 2 of 2 |" in printed
+
+
+def test_prototype_and_minirocket_rows(tmp_path, capsys):
+    """The prototype rows keep their decision and the nearest centroid's accuracy beside
+    their own; MiniRocket runs on unequal lengths through resampling."""
+    out = tmp_path / "results"
+    args = ["--datasets", "ItalyPowerDemand", "--methods", "rtw-default", "rtw-prototype",
+            "dba-prototype", "minirocket", "--epochs", "2", "--max-series-per-class", "8",
+            "--halves", "--out", str(out), "--quiet"]  # fmt: skip
+    assert main(args) == 0
+    record = json.loads((out / "datasets" / "ItalyPowerDemand.json").read_text())
+    for row in ("rtw-prototype", "dba-prototype"):
+        entry = record["methods"][row]
+        assert entry["decision"] in ("readout", "nearest")
+        assert 0.0 <= entry["nearest_accuracy"] <= 1.0
+        if entry["decision"] == "nearest":
+            assert entry["accuracy"] == entry["nearest_accuracy"]
+    assert record["methods"]["minirocket"]["accuracy"] > 0.5
+    summary = (out / "summary.md").read_text()
+    assert "The prototype classifier, RTWPrototypeClassifier()" in summary
+    assert "| rtw-prototype | minirocket |" in summary
+
+
+def test_series_are_resampled_to_one_length_for_minirocket():
+    from benchmarks.ucr._protocol import equal_length
+
+    ramp = [np.linspace(0.0, 1.0, 5), np.linspace(0.0, 1.0, 9)]
+    resampled = equal_length(ramp, 17)
+    np.testing.assert_allclose(resampled[:, :, 0], np.tile(np.linspace(0, 1, 17), (2, 1)))
+    stacked = np.zeros((3, 17))
+    assert equal_length(stacked, 17) is stacked
