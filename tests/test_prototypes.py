@@ -195,3 +195,17 @@ def test_pipeline_gridsearch_clone_pickle():
     assert grid.best_estimator_.readout_ is not grid.best_params_["readout"]  # cloned
     assert grid.best_estimator_.centroids_.method.max_iter == grid.best_params_["method__max_iter"]
     assert clone(base).get_params() == base.get_params()
+
+
+def test_a_class_of_one_series_gets_the_column_mean():
+    """Every class one series (every centroid a series): folds without stratification, and
+    a series' distance to itself is the mean of the others' distances to it."""
+    X, _ = three_shape_classes(n_per_class=2)
+    y = np.arange(len(X))
+    nc = RTWNearestCentroid(method=DBA(), n_centroids=1, dtw_window=0.1).fit(X, y)
+    D = out_of_fold_distances(nc, check_series_collection(X), y, 3, random_state=0)
+    full = np.array([[dtw_distance(a, b, window=0.1) for b in X] for a in X])
+    others = ~np.eye(len(X), dtype=bool)
+    np.testing.assert_allclose(D[others], full[others], rtol=1e-10)
+    expected = np.array([full[others[:, m], m].mean() for m in range(len(X))])
+    np.testing.assert_allclose(np.diag(D), expected, rtol=1e-10)

@@ -139,10 +139,18 @@ def _fill_unseen(distances: np.ndarray, codes: np.ndarray) -> np.ndarray:
     missing = np.isnan(distances)
     if not missing.any():
         return distances
+    seen = ~missing
+    values = np.where(seen, distances, 0.0)
+    n_classes = int(codes.max()) + 1
+    sums = np.zeros((n_classes, distances.shape[1]))
+    counts = np.zeros((n_classes, distances.shape[1]))
+    np.add.at(sums, codes, values)
+    np.add.at(counts, codes, seen)
+    overall = values.sum(0) / np.maximum(seen.sum(0), 1)
+    rows, columns = np.nonzero(missing)
+    same = counts[codes[rows], columns]
     filled = distances.copy()
-    for i, m in zip(*np.nonzero(missing), strict=True):
-        column = distances[:, m]
-        same = column[(codes == codes[i]) & ~np.isnan(column)]
-        pool = same if len(same) else column[~np.isnan(column)]
-        filled[i, m] = pool.mean() if len(pool) else 0.0
+    filled[rows, columns] = np.where(
+        same > 0, sums[codes[rows], columns] / np.maximum(same, 1), overall[columns]
+    )
     return filled
