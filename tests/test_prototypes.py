@@ -209,3 +209,20 @@ def test_a_class_of_one_series_gets_the_column_mean():
     np.testing.assert_allclose(D[others], full[others], rtol=1e-10)
     expected = np.array([full[others[:, m], m].mean() for m in range(len(X))])
     np.testing.assert_allclose(np.diag(D), expected, rtol=1e-10)
+
+
+def test_a_random_state_object_gives_one_reproducible_fit():
+    """With a RandomState the fit draws one integer seed: the nearest-centroid fit keeps
+    it, and the out-of-fold distances recomputed from it are the fitted ones (the refits
+    used the fit's seeds and folds)."""
+    X, y = three_shape_classes()
+    clf = RTWPrototypeClassifier(method=quick(), n_centroids=2, dtw_window=0.1, cv=3,
+                                 random_state=np.random.RandomState(5)).fit(X, y)  # fmt: skip
+    seed = clf.centroids_.random_state
+    assert isinstance(seed, int)
+    again = out_of_fold_distances(clf.centroids_, check_series_collection(X), y, 3,
+                                  random_state=seed)  # fmt: skip
+    np.testing.assert_array_equal(again, clf.oof_distances_)
+    twin = RTWPrototypeClassifier(method=quick(), n_centroids=2, dtw_window=0.1, cv=3,
+                                  random_state=np.random.RandomState(5)).fit(X, y)  # fmt: skip
+    np.testing.assert_array_equal(twin.oof_distances_, clf.oof_distances_)

@@ -56,7 +56,9 @@ def out_of_fold_distances(
     n_folds : int
         Stratified folds (at most the size of the largest class).
     random_state : int, RandomState or None
-        Draws the folds and the refits' seeds, as the fit drew its seeds.
+        Draws the folds. The refits' seeds are drawn from ``centroids.random_state`` as
+        the fit drew them: the same seeds when it is an integer (as
+        :class:`RTWPrototypeClassifier` makes it).
     owner : str
         The estimator's name, for the ``verbose`` lines.
 

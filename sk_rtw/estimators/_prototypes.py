@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from numbers import Integral
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -260,12 +261,19 @@ class RTWPrototypeClassifier(ClassifierMixin, TransformerMixin, BaseEstimator):
             )
         params = validate_parameters(self)  # every parameter checked before any work
         readout = default_readout() if params["readout"] is None else clone(params["readout"])
+        # one integer seed for the whole fit: the refits then get the seeds the fit drew
+        # and the decision's cross-validation the folds of the out-of-fold distances,
+        # whatever random_state is (an int, None, a RandomState or a Generator)
+        seed = self.random_state
+        if not isinstance(seed, Integral):
+            seed = int(check_random_state(seed).randint(2**31 - 1))
         shared = {name: getattr(self, name) for name in CENTROID_PARAMETERS}
-        centroids = RTWNearestCentroid(**shared, temperature=1.0).fit(X, y)
+        centroids = RTWNearestCentroid(**{**shared, "random_state": seed}, temperature=1.0)
+        centroids.fit(X, y)
         collection = check_series_collection(X, centroids.manifold_)
         _, codes = _encode(_check_labels(y, collection.n_series, True))
         distances = out_of_fold_distances(
-            centroids, collection, codes, params["cv"], random_state=self.random_state,
+            centroids, collection, codes, params["cv"], random_state=seed,
             owner=type(self).__name__,
         )  # fmt: skip
         class_distances = np.stack(
@@ -277,7 +285,7 @@ class RTWPrototypeClassifier(ClassifierMixin, TransformerMixin, BaseEstimator):
         self.distance_scale_ = float(np.median(positive)) if len(positive) else 1.0
         features = self._features(distances)
         self.decision_, self.cv_accuracy_ = self._decide(
-            params["decision"], readout, features, class_distances, codes, params["cv"]
+            params["decision"], readout, features, class_distances, codes, params["cv"], seed
         )
         readout.fit(features, codes)
         self.centroids_ = centroids
@@ -292,13 +300,14 @@ class RTWPrototypeClassifier(ClassifierMixin, TransformerMixin, BaseEstimator):
             self.n_features_in_ = centroids.n_features_in_
         return self
 
-    def _decide(self, decision, readout, features, class_distances, codes, n_folds):
-        """``decision_`` and the cross-validated accuracies behind it."""
+    def _decide(self, decision, readout, features, class_distances, codes, n_folds, seed):
+        """``decision_`` and the cross-validated accuracies behind it, on the folds of the
+        out-of-fold distances (drawn from ``seed`` as they were)."""
         if decision != "auto":
             return decision, {}
-        seed = check_random_state(self.random_state).randint(2**31 - 1)
         predicted = np.empty_like(codes)
-        for train, test in split_folds(n_folds, codes, seed):
+        fold_seed = check_random_state(seed).randint(2**31 - 1)
+        for train, test in split_folds(n_folds, codes, fold_seed):
             if len(np.unique(codes[train])) < 2:  # a fold without a second class
                 predicted[test] = codes[train][0]
                 continue
