@@ -59,6 +59,12 @@ ERRORS = [
         "from_aeon",
     ),
     (
+        "aeon channels-first: the aeon-native entry point named",
+        lambda: fit_classifier(np.zeros((6, 1, 150))),
+        ValueError,
+        "sk_rtw.aeon.RTWClassifier",
+    ),
+    (
         "aeon channels-first univariate",
         lambda: align(np.zeros((6, 1, 150))),
         ValueError,

@@ -275,7 +275,8 @@ def _reject_unsupported_containers(X: Any, name: str) -> None:
 #: How to convert aeon data, for error messages.
 AEON_HINT = (
     "sk_rtw is time-major, (n_series, n_timepoints[, n_channels]); aeon's channels-first "
-    "arrays (n_cases, n_channels, n_timepoints) convert with sk_rtw.utils.from_aeon(X)"
+    "arrays (n_cases, n_channels, n_timepoints) convert with sk_rtw.utils.from_aeon(X), "
+    "or take sk_rtw.aeon.RTWClassifier, which reads aeon's layouts as they are"
 )
 
 
