@@ -137,3 +137,41 @@ def subsample_per_class(split: Split, max_per_class: int | None, seed: int) -> n
 def take(split: Split, index: np.ndarray) -> Split:
     X = split.X[index] if isinstance(split.X, np.ndarray) else [split.X[i] for i in index]
     return Split(X=X, y=split.y[index], lengths=split.lengths[index], notes=split.notes)
+
+
+def resample_split(train: Split, test: Split, resample: int) -> tuple[Split, Split]:
+    """The archive's split (``resample`` 0) or its stratified resample ``resample``.
+
+    aeon's and tsml-eval's resampling (``stratified_resample_data``, seeded by the
+    resample number): train and test pooled, every class's cases shuffled, and the first
+    as many as the class has in the archive's training split go to training, so class
+    counts stay those of the archive. Works on the loaded splits (after missing values
+    were filled), with aeon's own index function, so that a resample here is the same
+    cases as resample ``resample`` of a tsml-eval experiment.
+    """
+    if resample == 0:
+        return train, test
+    from aeon.benchmarking.resampling import stratified_resample_data_indices
+
+    train_index, test_index = stratified_resample_data_indices(
+        train.y, test.y, random_state=resample
+    )
+    pooled = _pool(train, test)
+    return take(pooled, train_index), take(pooled, test_index)
+
+
+def _pool(train: Split, test: Split) -> Split:
+    if (
+        isinstance(train.X, np.ndarray)
+        and isinstance(test.X, np.ndarray)
+        and (train.X.shape[1:] == test.X.shape[1:])
+    ):
+        X = np.concatenate([train.X, test.X])
+    else:
+        X = [*train.X, *test.X]
+    return Split(
+        X=X,
+        y=np.concatenate([train.y, test.y]),
+        lengths=np.concatenate([train.lengths, test.lengths]),
+        notes=train.notes + test.notes,
+    )

@@ -55,6 +55,7 @@ from pathlib import Path
 
 import numpy as np
 from scipy import stats
+from scipy.special import softmax
 
 from sk_rtw import (
     Alignment,
@@ -67,7 +68,7 @@ from sk_rtw.estimators._selection import WINDOWS
 from sk_rtw.utils import to_aeon
 
 from .._shared import method_object
-from ._data import Split, load_split, subsample_per_class, take
+from ._data import Split, load_split, resample_split, subsample_per_class, take
 
 ALPHA = 0.05
 #: Result files are readable by everyone (rw-r--r--), like any file the user writes.
@@ -129,6 +130,22 @@ class RunConfig:
     out: str = "results/ucr"
     verbose: int = 1
     resume: bool = False
+    resample: int = 0
+
+
+def record_path(out: str | Path, name: str, resample: int = 0) -> Path:
+    """Where a dataset's result file lives: ``datasets/<name>.json`` for the archive's
+    split (resample 0), ``resamples/<name>/resample<r>.json`` for resample ``r``."""
+    if resample == 0:
+        return Path(out) / "datasets" / f"{name}.json"
+    return Path(out) / "resamples" / name / f"resample{resample}.json"
+
+
+def one_hot(predictions, classes) -> np.ndarray:
+    """Probabilities of a classifier without a graded score: 1 for the predicted class
+    (what aeon's ``predict_proba`` gives for 1-NN and for MiniRocket's ridge readout)."""
+    classes = np.asarray(classes)
+    return (np.asarray(predictions)[:, None] == classes[None, :]).astype(float)
 
 
 def atomic_write_json(path: Path, payload: dict) -> None:
@@ -203,14 +220,24 @@ def _fit_estimator(method, train, test, config):
             "cv_accuracy": readout.cv_accuracy_,
             "nearest_accuracy": float(np.mean(nearest == test.y)),
         }
+    # untimed, as predict_proba would give them: the softmax of the distances already
+    # computed, or the readout's probabilities where it has them
+    if not prototype:
+        probabilities = softmax(-distances / estimator.temperature_, axis=1)
+    elif hasattr(readout, "predict_proba"):
+        probabilities = readout.predict_proba(test.X)
+    else:
+        probabilities = one_hot(predictions, estimator.classes_)
     return {
         "fit_seconds": fit_seconds,
         "predict_seconds": predict_seconds,
         "alignment": alignment,
         "barycenter": barycenter,
         "predictions": predictions,
+        "probabilities": probabilities,
         "test_distances": distances,
         "classes": estimator.classes_,
+        "parameters": repr(readout),
         "best_epochs": [
             a.best_epoch if isinstance(a, Alignment) else -1 for a in estimator.alignments_
         ],
@@ -268,6 +295,7 @@ def _fit_1nn(train, test, config):
         "predict_seconds": time.perf_counter() - start,
         "predictions": predictions,
         "classes": classifier.classes_,
+        "parameters": repr(classifier),
     }
 
 
@@ -303,6 +331,7 @@ def _fit_minirocket(train, test, config):
         "predict_seconds": time.perf_counter() - start,
         "predictions": predictions,
         "classes": classifier.classes_,
+        "parameters": repr(classifier),
     }
 
 
@@ -411,7 +440,11 @@ def warm_up(methods) -> None:
 
 #: The run settings an estimator row's result depends on (a seed-free row: only the
 #: subsampling, and the seed when there is one).
-RESULT_SETTINGS = ("epochs", "max_series_per_class", "output_length", "device", "seed")
+RESULT_SETTINGS = (
+    "epochs", "max_series_per_class", "output_length", "device", "seed", "resample",
+)  # fmt: skip
+#: Settings added after results were first written: an older record ran with this value.
+SETTING_DEFAULTS = {"resample": 0}
 
 
 def reusable(record: dict | None, config: RunConfig) -> dict:
@@ -421,9 +454,11 @@ def reusable(record: dict | None, config: RunConfig) -> dict:
     if not record or record.get("error") is not None:
         return {}
     before, now = record.get("config", {}), asdict(config)
-    same = all(before.get(k) == now[k] for k in RESULT_SETTINGS)
-    same_split = before.get("max_series_per_class") == now["max_series_per_class"] and (
-        now["max_series_per_class"] is None or before.get("seed") == now["seed"]
+    same = all(before.get(k, SETTING_DEFAULTS.get(k)) == now[k] for k in RESULT_SETTINGS)
+    same_split = (
+        before.get("max_series_per_class") == now["max_series_per_class"]
+        and before.get("resample", 0) == now["resample"]
+        and (now["max_series_per_class"] is None or before.get("seed") == now["seed"])
     )
     return {
         method: entry
@@ -446,11 +481,13 @@ def _process_dataset(name, config, position, on_method_done) -> dict:
     warm_up(config.methods)
     start = time.perf_counter()
     record = {"dataset": name, "config": asdict(config), "methods": {}, "error": None}
-    path = Path(config.out) / "datasets" / f"{name}.json"
+    record["resample"] = config.resample
+    path = record_path(config.out, name, config.resample)
     done = reusable(read_record(path), config) if config.resume else {}
     try:
         train = load_split(name, "train", config.data_dir)
         test = load_split(name, "test", config.data_dir)
+        train, test = resample_split(train, test, config.resample)
         kept = subsample_per_class(train, config.max_series_per_class, config.seed)
         record.update(
             n_train_total=len(train.y),
@@ -497,6 +534,8 @@ def _process_dataset(name, config, position, on_method_done) -> dict:
                 atomic_write_json(path, record)
                 on_method_done(method)
                 continue
+            if "probabilities" not in out:  # the reference rows: aeon's predict_proba
+                out["probabilities"] = one_hot(out["predictions"], out["classes"])
             correct = (np.asarray(out["predictions"]) == test.y).astype(int)
             out["correct"] = correct
             out["accuracy"] = float(correct.mean())

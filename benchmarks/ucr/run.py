@@ -13,6 +13,8 @@ Examples::
     python benchmarks/ucr/run.py --data-dir ../shared/ucr --datasets CBF Coffee --methods rtw dba
     python benchmarks/ucr/run.py --methods rtw rtw-paper dba --epochs 64 -v
     python benchmarks/ucr/run.py --all --jobs 8 --backend dask --scheduler tcp://host:8786
+    python benchmarks/ucr/run.py --data-dir ../shared/ucr --half A --resamples 10 --jobs 2 \
+        --methods rtw-default rtw-prototype 1nn-dtw minirocket --resume
 
 Nothing is downloaded: a dataset must be in --data-dir (aeon's local layout,
 <dir>/<name>/<name>_TRAIN.ts) or bundled with aeon (ArrowHead, GunPoint,
@@ -29,11 +31,20 @@ Results (``--out``, default ``results/ucr``)::
 
     datasets/<name>.json    one file per dataset, written atomically when it finishes:
                             configuration, per-method accuracy, fit time, per-training-
-                            series averaging values, per-test-series predictions and
-                            distances, paired t-tests, errors
-    summary.md              the tables printed at the end
+                            series averaging values, per-test-series predictions,
+                            probabilities and distances, paired t-tests, errors
+    resamples/<name>/resample<r>.json
+                            the same for resample r >= 1 (--resamples)
+    summary.md              the tables printed at the end (of the archive's split; with
+                            --resamples also the means over resamples and paired tests)
     accuracy_scatter.png    RTW against TTW/NTW/DBA accuracy per dataset
     critical_difference.png aeon's critical-difference diagram of the accuracies
+    tsml/<Classifier>/Predictions/<name>/testResample<r>.csv
+                            tsml-format predictions with per-case probabilities, read by
+                            aeon's and tsml-eval's evaluation (benchmarks/ucr/_tsml.py)
+    tsml/classification/<measure>/<Classifier>_<measure>.csv
+                            a row per dataset, a column per resample: the layout aeon's
+                            get_estimator_results(path=...) reads
 
 A dataset's file is written again after each of its methods. ``--resume`` keeps every
 method already there that was computed with the same settings (the seed-free 1-NN rows
@@ -51,6 +62,7 @@ import platform
 import shlex
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the repository; then _shared
@@ -79,15 +91,19 @@ from benchmarks.ucr._protocol import (
     RunConfig,
     process_dataset,
     read_record,
+    record_path,
     reusable,
 )
+from benchmarks.ucr._resamples import load_resample_records, resamples_markdown
 from benchmarks.ucr._summary import (
+    FIXED_HALVES,
     critical_difference_plot,
     load_records,
     markdown,
     scatter_plot,
     verdict,
 )
+from benchmarks.ucr._tsml import export as export_tsml
 from sk_rtw._settings import check_device
 from sk_rtw.align import PRESETS
 
@@ -114,6 +130,12 @@ def parse_args(argv=None) -> argparse.Namespace:
     )
     which.add_argument(
         "--all", action="store_true", help="every dataset in --data-dir plus aeon's bundled ones"
+    )
+    which.add_argument(
+        "--half",
+        choices=list(FIXED_HALVES),
+        help="the datasets of one fixed half: A or B of the development archive, C1 or C2 "
+        "of the large training sets (see --halves)",
     )
     parser.add_argument(
         "--methods",
@@ -149,6 +171,15 @@ def parse_args(argv=None) -> argparse.Namespace:
         type=non_negative_int,
         default=0,
         help="random_state of every method and of subsampling",
+    )
+    parser.add_argument(
+        "--resamples",
+        type=positive_int,
+        default=1,
+        metavar="K",
+        help="resamples 0 .. K-1 of every dataset (default 1): 0 is the archive's split, "
+        "the others aeon's and tsml-eval's stratified resamples seeded by their number; "
+        "every method keeps --seed on every resample",
     )
     parser.add_argument(
         "--jobs", type=job_count, default=1, help="datasets in parallel (-1: one per core)"
@@ -215,13 +246,16 @@ def select_datasets(args) -> list[str]:
         return list(args.datasets)
     if args.all:
         return available_datasets(args.data_dir)
+    if args.half:
+        return list(FIXED_HALVES[args.half])
     return list(AEON_BUNDLED)
 
 
 def finished(out: Path, name: str, config: RunConfig) -> bool:
-    """Whether ``--resume`` has nothing left to do for a dataset: every requested method
-    is in its result file, computed with this run's settings."""
-    record = read_record(out / "datasets" / f"{name}.json")
+    """Whether ``--resume`` has nothing left to do for a dataset (at the config's
+    resample): every requested method is in its result file, computed with this run's
+    settings."""
+    record = read_record(record_path(out, name, config.resample))
     return set(reusable(record, config)) == set(config.methods)
 
 
@@ -242,29 +276,35 @@ def progress_bar(n_datasets: int, n_methods: int, enabled: bool):
     )
 
 
-def run_all(names: list[str], config: RunConfig, jobs: int, backend: str, scheduler, bar=None):
+def run_all(
+    tasks: list[tuple[str, RunConfig]], jobs: int, backend: str, scheduler, bar=None,
+    resamples: bool = False,
+):  # fmt: skip
+    """Every (dataset, config) task: in this process for one job, else on joblib."""
     from joblib import Parallel, delayed, parallel_config
 
-    total = len(names)
-    n_methods = len(config.methods)
+    total = len(tasks)
+
+    def position(i: int, config: RunConfig) -> str:
+        return f"[{i + 1:>3}/{total}]" + (f" resample {config.resample}" if resamples else "")
 
     def advance(record: dict) -> dict:
         if bar is not None:
-            bar.update(n_methods)
+            bar.update(len(record["config"]["methods"]))
             bar.set_postfix_str(record["dataset"], refresh=False)
         return record
 
     if jobs == 1 and backend != "dask":  # method-level progress in this process
         records = []
-        for i, name in enumerate(names):
+        for i, (name, config) in enumerate(tasks):
             if bar is not None:
                 bar.set_postfix_str(name)
             tick = (lambda method: bar.update(1)) if bar is not None else None
-            records.append(process_dataset(name, config, f"[{i + 1:>3}/{total}]", tick))
+            records.append(process_dataset(name, config, position(i, config), tick))
         return records
     tasks = [
-        delayed(process_dataset)(name, config, f"[{i + 1:>3}/{total}]")
-        for i, name in enumerate(names)
+        delayed(process_dataset)(name, config, position(i, config))
+        for i, (name, config) in enumerate(tasks)
     ]
     if backend == "dask":
         client = connect(scheduler, jobs)
@@ -306,16 +346,25 @@ def main(argv=None) -> int:
         verbose=0 if args.quiet else 1 + args.verbose,
         resume=args.resume,
     )
-    todo = [n for n in names if not (args.resume and finished(out, n, config))]
+    tasks = [
+        (name, replace(config, resample=resample))
+        for resample in range(args.resamples)
+        for name in names
+        if not (args.resume and finished(out, name, replace(config, resample=resample)))
+    ]
+    n_all = len(names) * args.resamples
+    what = f"{len(names)} dataset(s)" + (
+        f" x {args.resamples} resamples" if args.resamples > 1 else ""
+    )
     print(
-        f"{len(names)} dataset(s), {len(names) - len(todo)} already done; methods "
+        f"{what}, {n_all - len(tasks)} already done; methods "
         f"{', '.join(args.methods)}; {args.epochs} epochs; results in {out}",
         file=sys.stderr,
     )
     start = time.perf_counter()
-    bar = progress_bar(len(todo), len(args.methods), enabled=not args.quiet)
+    bar = progress_bar(len(tasks), len(args.methods), enabled=not args.quiet)
     try:
-        run_all(todo, config, args.jobs, args.backend, args.scheduler, bar)
+        run_all(tasks, args.jobs, args.backend, args.scheduler, bar, args.resamples > 1)
     finally:
         if bar is not None:
             bar.close()
@@ -326,11 +375,18 @@ def main(argv=None) -> int:
     machine = (
         f"{platform.machine()}, {os.cpu_count()} cores, Python "
         f"{platform.python_version()}, device {args.device}; "
-        f"{time.perf_counter() - start:.0f} s for {len(todo)} dataset(s)"
+        f"{time.perf_counter() - start:.0f} s for {len(tasks)} dataset(s)"
+        + (" x resample" if args.resamples > 1 else "")
     )
     text = markdown(records, list(args.methods), command.strip(), machine, halves=args.halves)
+    every_resample = load_resample_records(out, names, args.resamples)
+    if args.resamples > 1:
+        text += "\n" + "\n".join(
+            resamples_markdown(every_resample, list(args.methods), args.resamples)
+        )
     (out / "summary.md").write_text(text)
     written = [out / "summary.md"]
+    tsml = export_tsml(every_resample, list(args.methods), out / "tsml", args.resamples)
     if scatter_plot(records, out / "accuracy_scatter.png"):
         written.append(out / "accuracy_scatter.png")
     skipped = critical_difference_plot(
@@ -342,6 +398,10 @@ def main(argv=None) -> int:
         path.chmod(0o644)
     print(text)
     print("written: " + ", ".join(str(p) for p in written))
+    print(
+        f"tsml results: {tsml['predictions']} prediction file(s) and "
+        f"{len(tsml['summaries'])} summary file(s) under {out / 'tsml'}"
+    )
     if skipped is not None:
         print(f"critical-difference diagram not drawn: {skipped}")
     print("\n".join(verdict(records, list(args.methods))))

@@ -124,9 +124,7 @@ def choices_table(records: dict[int, dict[str, dict]], names: list[str]) -> list
             f"({e['methods'][DEFAULT]['dtw_window']}, {e['methods'][DEFAULT]['n_centroids']!r})"
             for e in entries
         ]
-        counts = [
-            str(sum(e["methods"][DEFAULT]["selection"]["class_centroids"])) for e in entries
-        ]
+        counts = [str(sum(e["methods"][DEFAULT]["selection"]["class_centroids"])) for e in entries]
         fits = [
             f"{e['methods'][DEFAULT]['fit_seconds']:.1f} / "
             f"{e['methods'][ONE_MEAN]['fit_seconds']:.1f}"
