@@ -212,3 +212,21 @@ def test_tsml_eval_reads_and_evaluates_the_files(two_resamples, tmp_path):
     assert len(loaded) == len(names) * len(DATASETS) * 2
     summary = (tmp_path / "check" / "Accuracy" / "accuracy_mean.csv").read_text()
     assert all(name in summary for name in names)
+
+
+def test_critical_difference_diagram_from_the_files(two_resamples, tmp_path, capsys):
+    from benchmarks.ucr.critical_difference import main as cd_main
+
+    picture = tmp_path / "cd.png"
+    assert cd_main([str(two_resamples / "tsml"), "--out", str(picture)]) == 0
+    assert picture.stat().st_size > 0
+    printed = capsys.readouterr().out
+    for method in METHODS:
+        accuracies = [
+            json.loads((two_resamples / f"{path}.json").read_text())["methods"][method]["accuracy"]
+            for dataset in DATASETS
+            for path in (f"datasets/{dataset}", f"resamples/{dataset}/resample1")
+        ]
+        assert f"{tsml_name(method)}: mean accuracy {np.mean(accuracies):.4f}" in printed
+    with pytest.raises(SystemExit, match="no accuracy summary for HC2"):
+        cd_main([str(two_resamples / "tsml"), "--classifiers", "HC2", "MiniROCKET", "1NN-DTW"])
