@@ -92,3 +92,39 @@ def test_zero_readout_init_starts_at_the_identity_with_diverse_hidden_units():
     weights = torch.randn(4, 30, generator=torch.Generator().manual_seed(0))
     (model(zhat) * weights).sum().backward()
     assert model.w3.grad.abs().sum() > 0
+
+
+def test_a_single_precision_network_gives_float64_warps_close_to_double():
+    zhat = torch.linspace(0.0, 1.0, 300, dtype=torch.float64)
+    double = NeuralWarps(6, 32, "xavier", knots=40, seeds=[3])
+    single = NeuralWarps(6, 32, "xavier", knots=40, seeds=[3], dtype=torch.float32)
+    assert all(p.dtype == torch.float32 for p in single.parameters())
+    # the same initial draws, rounded
+    torch.testing.assert_close(single.w2.double(), double.w2, rtol=1e-7, atol=1e-7)
+    warps = single(zhat)
+    assert warps.dtype == torch.float64
+    torch.testing.assert_close(warps, double(zhat), rtol=0, atol=1e-6)
+    # the identity part stays exact: the ends are 0 and 1 in float64
+    assert torch.equal(warps[:, 0], torch.zeros(6, dtype=torch.float64))
+    assert torch.equal(warps[:, -1], torch.ones(6, dtype=torch.float64))
+    warps.square().sum().backward()
+    assert all(p.grad is not None and p.grad.dtype == torch.float32 for p in single.parameters())
+    assert all(torch.isfinite(p.grad).all() for p in single.parameters())
+
+
+@pytest.mark.parametrize("method", ["rtw", "ntw"])
+def test_align_in_single_precision_matches_double_within_float32(method):
+    from sk_rtw import align
+    from sk_rtw.datasets import make_warped_signals
+
+    data = make_warped_signals("euclidean", 8, 60, random_state=0)
+    runs = {
+        dtype: align(data.signals, method=method, n_epochs=30, random_state=0, warp_dtype=dtype)
+        for dtype in ("float64", "float32")
+    }
+    single, double = runs["float32"], runs["float64"]
+    assert single.config.warp_dtype == "float32" and double.config.warp_dtype == "float64"
+    assert single.warps.dtype == np.float64 and single.mean.dtype == np.float64
+    best = np.nanmin(double.loss_history)
+    assert np.nanmin(single.loss_history) == pytest.approx(best, rel=1e-3)
+    np.testing.assert_allclose(single.warps, double.warps, atol=1e-3)

@@ -131,6 +131,15 @@ KNOBS: dict[str, Knob] = {
             "between; None: every output time (the paper).",
             _every(None, _NEURAL),
         ),
+        Knob(
+            "warp_dtype",
+            (Options(("float32", "float64")),),
+            'Precision of the warp network, its inputs and its Adam moments: "float32" '
+            "(the warps are cast to float64 before interpolation; the manifold operations, "
+            'means and losses stay float64) or "float64" throughout (results identical to '
+            "float64 runs, or offsets finer than float32's 6e-8 of the time axis).",
+            _every("float64", _NEURAL),
+        ),
         Knob("n_components", _integer(1), "Sine terms K of the TTW warps.", {"ttw": 8}),
         Knob(
             "tangent_refinements",

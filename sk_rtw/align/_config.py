@@ -23,11 +23,11 @@ class AlignmentConfig:
     """The resolved configuration of one engine run (RTW, TTW or NTW).
 
     Every field is the value actually used; fields of knobs the method does not have
-    (``hidden_size``, ``init`` and ``warp_knots`` for TTW's sine warps, ``n_components``
-    for the networks of RTW and NTW) are None. ``output_length`` is ``Z``, the length of
-    ``Alignment.mean`` (shape ``(Z, *point_shape)``) and of every aligned series;
-    ``warp_start`` is ``"given"`` when starting warps were passed as an array;
-    ``dtw_window`` is the Sakoe-Chiba band of the DTW start (None: none). See
+    (``hidden_size``, ``init``, ``warp_knots`` and ``warp_dtype`` for TTW's sine warps,
+    ``n_components`` for the networks of RTW and NTW) are None. ``output_length`` is
+    ``Z``, the length of ``Alignment.mean`` (shape ``(Z, *point_shape)``) and of every
+    aligned series; ``warp_start`` is ``"given"`` when starting warps were passed as an
+    array; ``dtw_window`` is the Sakoe-Chiba band of the DTW start (None: none). See
     :func:`sk_rtw.align` and the knobs table of the user guide for each field.
     """
 
@@ -59,6 +59,7 @@ class AlignmentConfig:
     cuda_graph: bool = False
     dtw_window: float | None = None
     refine_steps: int = 0
+    warp_dtype: str | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """The configuration as a plain dictionary (field name to value).

@@ -149,7 +149,7 @@ class Trainer:
         # fused Adam: one kernel for all parameters (CPU and CUDA alike), torch.optim's
         # kernel without its first-call import of torch._dynamo (see _adam.py)
         self.optimiser = FusedAdam(parameters, lr=learning_rate)
-        dtype = parameters[0].dtype
+        dtype = torch.float64  # the losses' (a float32 warp network's too)
         if parameter_groups is None:
             parameter_groups = [torch.zeros(p.shape[0] if p.ndim else 1, dtype=torch.long)
                                 for p in parameters]  # fmt: skip

@@ -193,6 +193,10 @@ class NeuralWarps(nn.Module):
     seeds : sequence of int, optional
         Seed of every group's initialisation (default: drawn from torch's global
         generator).
+    dtype : torch.dtype, default=torch.float64
+        Of the weights, the network's inputs and (through the parameters) the Adam
+        moments (the ``warp_dtype`` knob); the offsets are returned in the times' dtype.
+        The initial weights are the same draws in either precision.
     """
 
     def __init__(
@@ -293,15 +297,17 @@ class NeuralWarps(nn.Module):
         """``sum_k phi_theta(zhat)_k e_{k+1}`` of every series, shape (N, Z)."""
         if self.n_outputs < 1:
             raise RuntimeError("groups of one signal have no warp offsets")
-        times = zhat
+        dtype = self.w1.dtype  # the network's (float32 or float64); the offsets: zhat's
+        times = zhat.to(dtype)
         resample = self.knots is not None and self.knots < zhat.shape[0]
         if resample:
             assert self.knots is not None
-            times = unit_time(self.knots, dtype=zhat.dtype, device=zhat.device)
+            times = unit_time(self.knots, dtype=dtype, device=zhat.device)
         padded = torch.nn.functional.pad(self.network(times), (1, 0))  # (G, K, N_max)
         dot = padded @ self.u.unsqueeze(-1)  # (G, K, 1)
         combined = padded - self.scale * dot * self.u.unsqueeze(1)
         per_series = combined.transpose(1, 2).reshape(-1, times.shape[0])[self._rows]
+        per_series = per_series.to(zhat.dtype)
         if not resample:
             return per_series
         left, weight = self._knot_stencil(zhat)
@@ -396,4 +402,7 @@ def build_warps(
         assert config.n_components is not None  # resolved for TTW
         return SineWarps(layout, config.n_components)
     assert config.hidden_size is not None and config.init is not None  # resolved for RTW, NTW
-    return NeuralWarps(layout, config.hidden_size, config.init, config.warp_knots, seeds)
+    dtype = torch.float32 if config.warp_dtype == "float32" else torch.float64
+    return NeuralWarps(
+        layout, config.hidden_size, config.init, config.warp_knots, seeds, dtype=dtype
+    )

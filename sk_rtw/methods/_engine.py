@@ -89,6 +89,7 @@ class RTW(EngineMethod):
         init: str = "auto",
         hidden_size: int | str = "auto",
         warp_knots: int | str | None = "auto",
+        warp_dtype: str = "auto",
         tangent_refinements: int | str = "auto",
         mean_iterations: int | str = "auto",
         mean_start: str = "auto",
@@ -112,6 +113,7 @@ class RTW(EngineMethod):
         self.init = init
         self.hidden_size = hidden_size
         self.warp_knots = warp_knots
+        self.warp_dtype = warp_dtype
         self.tangent_refinements = tangent_refinements
         self.mean_iterations = mean_iterations
         self.mean_start = mean_start
@@ -189,6 +191,7 @@ class NTW(EngineMethod):
         init: str = "auto",
         hidden_size: int | str = "auto",
         warp_knots: int | str | None = "auto",
+        warp_dtype: str = "auto",
         tangent_refinements: int | str = "auto",
         mean_iterations: int | str = "auto",
         mean_start: str = "auto",
@@ -212,6 +215,7 @@ class NTW(EngineMethod):
         self.init = init
         self.hidden_size = hidden_size
         self.warp_knots = warp_knots
+        self.warp_dtype = warp_dtype
         self.tangent_refinements = tangent_refinements
         self.mean_iterations = mean_iterations
         self.mean_start = mean_start
