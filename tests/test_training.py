@@ -108,26 +108,34 @@ def _groups_data():
     return list(a) + list(b), np.array([0] * 5 + [1] * 3)
 
 
-@pytest.mark.parametrize("method", ["rtw", "ttw", "ntw"])
-def test_groups_in_one_batch_equal_separate_fits(method):
+@pytest.mark.parametrize(
+    ("method", "dtype"),
+    [("rtw", "float64"), ("rtw", "float32"), ("ttw", None), ("ntw", "float64"),
+     ("ntw", "float32")],
+)  # fmt: skip
+def test_groups_in_one_batch_equal_separate_fits(method, dtype):
+    """In float64 to rounding; a float32 network's batched products round differently
+    from one group's (another blocking of the same sums), within float32's precision."""
     from sk_rtw.align import align_collection, resolve_config
     from sk_rtw.utils import check_series_collection
 
     series, codes = _groups_data()
     collection = check_series_collection(series, "sphere")
-    config = resolve_config(method, "alignment", {"output_length": 50, "n_epochs": 30})
+    knobs = {"output_length": 50, "n_epochs": 30, **({"warp_dtype": dtype} if dtype else {})}
+    config = resolve_config(method, "alignment", knobs)
     # align(random_state=s) seeds its one group with the first draw of default_rng(s)
     seeds = [int(np.random.default_rng(s).integers(2**31 - 1)) for s in (11, 22)]
     batch = align_collection(collection, codes, seeds, config)
+    tol = 1e-4 if dtype == "float32" else 1e-9
     for g, seed in enumerate((11, 22)):
         alone = align(
             [s for s, c in zip(series, codes, strict=True) if c == g], manifold="sphere",
-            method=method, output_length=50, n_epochs=30, random_state=seed,
+            method=method, random_state=seed, **knobs,
         )  # fmt: skip
         assert batch[g].n_iter == alone.n_iter and batch[g].best_epoch == alone.best_epoch
-        np.testing.assert_allclose(batch[g].warps, alone.warps, atol=1e-9)
-        np.testing.assert_allclose(batch[g].mean, alone.mean, atol=1e-9)
-        np.testing.assert_allclose(batch[g].loss_history, alone.loss_history, rtol=1e-9)
+        np.testing.assert_allclose(batch[g].warps, alone.warps, atol=tol)
+        np.testing.assert_allclose(batch[g].mean, alone.mean, atol=tol)
+        np.testing.assert_allclose(batch[g].loss_history, alone.loss_history, rtol=tol)
 
 
 @pytest.mark.parametrize(

@@ -106,6 +106,10 @@ class Preset:
 
 _ALIGNMENT_ENGINE = {
     "warp_knots": 64,
+    # the warp network in single precision: 1.5x faster align on N = 30, T = 100, every
+    # quality figure within its seeds' spread (docs/benchmarks/align_speed.md); the paper
+    # preset keeps float64
+    "warp_dtype": "float32",
     "tangent_refinements": 0,
     "mean_iterations": 2,
     "mean_start": "previous",
