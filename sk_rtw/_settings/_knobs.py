@@ -203,6 +203,14 @@ KNOBS: dict[str, Knob] = {
             {**_every(1e-4), "dba": 1e-5},
         ),
         Knob(
+            "start_patience",
+            (*_integer(2), Constant(None, "no such stop")),
+            "Stop after this many epochs if none beat the first epoch's loss (the DTW "
+            "start's) by tol and the loss is not falling back towards it (a new low within "
+            "the last 4 epochs, at most twice the start's loss), keeping the start.",
+            _every(None),
+        ),
+        Knob(
             "cuda_graph",
             (Boolean(),),
             "Capture each epoch in a CUDA graph on a CUDA device (see the GPU guide).",

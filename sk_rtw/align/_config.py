@@ -60,6 +60,7 @@ class AlignmentConfig:
     dtw_window: float | None = None
     refine_steps: int = 0
     warp_dtype: str | None = None
+    start_patience: int | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """The configuration as a plain dictionary (field name to value).

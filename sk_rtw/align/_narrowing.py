@@ -61,6 +61,7 @@ class BatchOptimisation:
             n_groups=n_groups,
             n_iter_no_change=config.n_iter_no_change,
             tol=config.tol,
+            start_patience=config.start_patience,
             cuda_graph=config.cuda_graph,
         )
         #: The whole problem's number of each of the trainer's groups.
@@ -86,7 +87,8 @@ class BatchOptimisation:
         done = self.trainer.epochs_done
         config = self.config
         note = early_stop_note(config.method, done, config.n_epochs, self.best_epoch,
-                               config.n_iter_no_change, config.tol)  # fmt: skip
+                               config.n_iter_no_change, config.tol,
+                               config.start_patience)  # fmt: skip
         if self.verbose and note:
             print(note, file=sys.stderr, flush=True)
         history[:done] = self.losses[:done]

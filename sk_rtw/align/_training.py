@@ -11,7 +11,17 @@ group follows exactly the trajectory of a separate fit. Per group the loop keeps
   ``MLPRegressor``): an epoch counts as no improvement unless its loss is below the best
   loss by more than ``tol`` times its size; after ``n_iter_no_change`` such epochs in a
   row the group stops: its best iterate is frozen. The loop ends when every group has
-  stopped or after ``n_epochs``.
+  stopped or after ``n_epochs``;
+* a stop that knows the start (``start_patience``): the first epoch's loss is the loss of
+  the warps training starts from (RTW's DTW start, composed with a zero readout). A group
+  that after ``start_patience`` epochs has not beaten it by more than ``tol`` stops
+  unless its loss is falling back towards it (a new low, by ``tol``, within the last
+  :data:`FALLING_EPOCHS` epochs, at most :data:`NEAR_START` times the start's loss): the
+  start is its best iterate and is kept, as the early stop would after
+  ``n_iter_no_change`` epochs. Adam's first steps from a fine start throw the warps far
+  from it; where they come back (short UCR series) they do so from near the start's loss
+  and while still descending; where they do not (long demonstrations: 100-9,000 times the
+  start's loss after the first step) those epochs buy nothing.
 
 A caller may pause the loop (``run(pause=...)``) and continue with the running groups
 only (:meth:`Trainer.narrow`): best iterates, counters, history and Adam's moments are
@@ -46,6 +56,11 @@ from ._adam import FusedAdam
 
 #: Eager epochs before a CUDA graph is captured (lets lazy allocations settle).
 WARMUP_EPOCHS = 3
+#: ``start_patience``: the loss is falling when it reached a new low within this many
+#: epochs ...
+FALLING_EPOCHS = 4
+#: ... and that low is at most this multiple of the start's loss.
+NEAR_START = 2.0
 
 
 def _group_shapes(parameter_groups, parameters, device) -> list[torch.Tensor]:
@@ -70,6 +85,12 @@ class GroupProgress:
     #: Epochs trained, and the loss of each (NaN once the group stopped).
     epochs_run: torch.Tensor
     history: torch.Tensor
+    #: The first epoch's loss (the start's), whether a later epoch beat it by tol, the
+    #: lowest loss after the first epoch and the epochs since it last fell by tol.
+    start_loss: torch.Tensor
+    beaten: torch.Tensor
+    low: torch.Tensor
+    since_low: torch.Tensor
     #: The caller's number of every group (a narrowed trainer's error messages name it).
     ids: np.ndarray
 
@@ -84,6 +105,10 @@ class GroupProgress:
             epochs_run=torch.zeros(n_groups, dtype=torch.long, device=device),
             history=torch.full(shape, math.nan, dtype=dtype, device=device),
             ids=np.arange(n_groups),
+            start_loss=torch.full((n_groups,), math.nan, dtype=dtype, device=device),
+            beaten=torch.zeros(n_groups, dtype=torch.bool, device=device),
+            low=torch.full((n_groups,), math.inf, dtype=dtype, device=device),
+            since_low=torch.zeros(n_groups, dtype=torch.long, device=device),
         )
 
     def select(self, groups: torch.Tensor) -> GroupProgress:
@@ -96,6 +121,10 @@ class GroupProgress:
             epochs_run=self.epochs_run[groups].clone(),
             history=self.history[:, groups].clone(),
             ids=self.ids[groups.cpu().numpy()],
+            start_loss=self.start_loss[groups].clone(),
+            beaten=self.beaten[groups].clone(),
+            low=self.low[groups].clone(),
+            since_low=self.since_low[groups].clone(),
         )
 
 
@@ -120,6 +149,10 @@ class Trainer:
         (None: never stop early).
     tol : float, default=1e-4
         Relative improvement that counts.
+    start_patience : int or None, default=None
+        Stop a group after this many epochs if none beat the first epoch's loss by more
+        than ``tol`` and its loss is not falling back towards it (see the module
+        docstring; None: no such stop).
     cuda_graph : bool, default=False
         Capture the epoch in a CUDA graph and replay it (CUDA devices only).
     """
@@ -134,6 +167,7 @@ class Trainer:
         n_groups: int = 1,
         n_iter_no_change: int | None = None,
         tol: float = 1e-4,
+        start_patience: int | None = None,
         cuda_graph: bool = False,
     ):
         self.loss_fn = loss_fn
@@ -143,6 +177,7 @@ class Trainer:
         self.n_groups = n_groups
         self.n_iter_no_change = n_iter_no_change
         self.tol = float(tol)
+        self.start_patience = start_patience
         device = parameters[0].device
         self.device = device
         self.cuda = device.type == "cuda"
@@ -194,9 +229,29 @@ class Trainer:
             )
             progress.epochs_run.add_(active.long())
             progress.stalled.copy_(torch.where(significant, 0, progress.stalled + 1))
-            active.copy_(active & (progress.stalled < self._limit))
+            keep = progress.stalled < self._limit
+            if self.start_patience is not None:
+                keep &= ~self._start_unbeaten(value)
+            active.copy_(active & keep)
             self.epoch += 1
         self.optimiser.step()
+
+    def _start_unbeaten(self, value: torch.Tensor) -> torch.Tensor:
+        """Update the start's bookkeeping with this epoch's losses; True for the groups
+        that ``start_patience`` stops now (no host-device synchronisation)."""
+        progress, tol = self.progress, self.tol
+        first = self.epoch == 0
+        start = progress.start_loss
+        start.copy_(torch.where(first, value, start))
+        later = ~first
+        progress.beaten.logical_or_(later & (value < start - tol * start.abs()))
+        low = progress.low
+        fell = later & ((value < low - tol * low.abs()) | torch.isinf(low))
+        low.copy_(torch.where(later, torch.minimum(low, value), low))
+        progress.since_low.copy_(torch.where(fell, 0, progress.since_low + 1))
+        falling = (progress.since_low < FALLING_EPOCHS) & (low <= NEAR_START * start)
+        waited = self.epoch + 1 >= self.start_patience
+        return waited & ~progress.beaten & ~falling
 
     def run(
         self,
@@ -354,18 +409,31 @@ def progress_printer(method: str, n_epochs: int, verbose: bool | int):
 
 
 def early_stop_note(
-    method: str, done: int, n_epochs: int, best_epoch: np.ndarray, n_iter_no_change, tol
+    method: str,
+    done: int,
+    n_epochs: int,
+    best_epoch: np.ndarray,
+    n_iter_no_change,
+    tol,
+    start_patience=None,
 ) -> str | None:
     """The ``verbose`` line of a run that stopped before ``n_epochs``, or None."""
-    if done >= n_epochs or n_iter_no_change is None:
+    if done >= n_epochs or (n_iter_no_change is None and start_patience is None):
         return None
     kept = (
         f"epoch {int(best_epoch[0])}"
         if len(best_epoch) == 1
         else f"each group's best epoch ({int(best_epoch.min())} to {int(best_epoch.max())})"
     )
+    # the no-change counter cannot stop a group before n_iter_no_change + 1 epochs
+    if n_iter_no_change is None or done <= n_iter_no_change:
+        reason = (
+            f"no epoch beat the start's loss by tol={tol} within start_patience="
+            f"{start_patience} epochs and the loss was not falling back towards it"
+        )
+    else:
+        reason = f"{n_iter_no_change} epochs without a relative gain of tol={tol}"
     return (
-        f"[{method}] stopped early after {done} of {n_epochs} epochs: {n_iter_no_change} "
-        f"epochs without a relative gain of tol={tol}; keeping the warps of {kept} "
-        "(best_epoch, numbered from 0)"
+        f"[{method}] stopped early after {done} of {n_epochs} epochs: {reason}; keeping the "
+        f"warps of {kept} (best_epoch, numbered from 0)"
     )

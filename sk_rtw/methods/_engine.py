@@ -99,6 +99,7 @@ class RTW(EngineMethod):
         start_axis: str = "auto",
         n_iter_no_change: int | str | None = "auto",
         tol: float | str = "auto",
+        start_patience: int | str | None = "auto",
         cuda_graph: bool | str = "auto",
         refine_steps: int | str = "auto",
     ) -> None:
@@ -123,6 +124,7 @@ class RTW(EngineMethod):
         self.start_axis = start_axis
         self.n_iter_no_change = n_iter_no_change
         self.tol = tol
+        self.start_patience = start_patience
         self.cuda_graph = cuda_graph
         self.refine_steps = refine_steps
 
@@ -150,6 +152,7 @@ class TTW(EngineMethod):
         start_axis: str = "auto",
         n_iter_no_change: int | str | None = "auto",
         tol: float | str = "auto",
+        start_patience: int | str | None = "auto",
         cuda_graph: bool | str = "auto",
         refine_steps: int | str = "auto",
     ) -> None:
@@ -171,6 +174,7 @@ class TTW(EngineMethod):
         self.start_axis = start_axis
         self.n_iter_no_change = n_iter_no_change
         self.tol = tol
+        self.start_patience = start_patience
         self.cuda_graph = cuda_graph
         self.refine_steps = refine_steps
 
@@ -201,6 +205,7 @@ class NTW(EngineMethod):
         start_axis: str = "auto",
         n_iter_no_change: int | str | None = "auto",
         tol: float | str = "auto",
+        start_patience: int | str | None = "auto",
         cuda_graph: bool | str = "auto",
         refine_steps: int | str = "auto",
     ) -> None:
@@ -225,5 +230,6 @@ class NTW(EngineMethod):
         self.start_axis = start_axis
         self.n_iter_no_change = n_iter_no_change
         self.tol = tol
+        self.start_patience = start_patience
         self.cuda_graph = cuda_graph
         self.refine_steps = refine_steps
