@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 import torch
 
+from .._heap import heap_for_temporaries
 from .._threads import limited_threads, threads_for
 from ..dtw import path_indices
 from ..utils import SeriesCollection
@@ -87,7 +88,10 @@ def align_collection(
         * collection.data[0, 0].size
         * (collection.max_length if config.sinc_window is None else 2 * config.sinc_window + 1)
     )
-    with limited_threads(threads_for(n_jobs, work)):
+    # one (N, Z, point) float64 array: the size of most of an epoch's temporaries
+    temporary = collection.n_series * output_length(config) * collection.data[0, 0].size * 8
+    on_cpu = torch.device(config.device).type == "cpu"
+    with limited_threads(threads_for(n_jobs, work)), heap_for_temporaries(on_cpu * temporary):
         model = build_warps(config, layout, torch_seeds).to(config.device)
         problem = Problem(collection, layout, config)
         if config.warp_start == "dtw" and layout.max_size > 1:

@@ -1,0 +1,50 @@
+"""Large temporaries kept in glibc's heap during a fit, the allocator left as glibc's
+adaptive rule would leave it afterwards; read back from glibc's own counters."""
+
+from __future__ import annotations
+
+import ctypes
+
+import numpy as np
+import pytest
+
+from sk_rtw._heap import LARGE_TEMPORARY, _glibc, heap_for_temporaries
+
+pytestmark = pytest.mark.skipif(_glibc() is None, reason="glibc's allocator only")
+
+
+class _MallInfo2(ctypes.Structure):
+    _fields_ = [(name, ctypes.c_size_t) for name in (
+        "arena", "ordblks", "smblks", "hblks", "hblkhd", "usmblks", "fsmblks", "uordblks",
+        "fordblks", "keepcost",
+    )]  # fmt: skip
+
+
+def _mmapped_bytes_of(nbytes: int) -> int:
+    """Bytes glibc serves by mmap for one live array of ``nbytes``."""
+    libc = _glibc()
+    if not hasattr(libc, "mallinfo2"):  # glibc < 2.33
+        pytest.skip("mallinfo2 needs glibc 2.33")
+    libc.mallinfo2.restype = _MallInfo2
+    before = libc.mallinfo2().hblkhd
+    block = np.empty(nbytes // 8)
+    block[::512] = 1.0  # touched, as a temporary is
+    used = libc.mallinfo2().hblkhd - before
+    del block
+    return used
+
+
+def test_a_large_fit_keeps_its_temporaries_in_the_heap_and_gives_them_back():
+    large = 128 * 2**20
+    assert _mmapped_bytes_of(large) >= large  # glibc's own choice for such a block
+    with heap_for_temporaries(large):
+        assert _mmapped_bytes_of(large) == 0
+        assert _mmapped_bytes_of(large) == 0  # freed and reused, never mmapped
+    assert _mmapped_bytes_of(large) >= large  # mmap allowed again afterwards
+    assert _mmapped_bytes_of(16 * 2**20) == 0  # below the 32 MB threshold left behind
+
+
+def test_a_small_fit_leaves_the_allocator_alone():
+    large = 128 * 2**20
+    with heap_for_temporaries(LARGE_TEMPORARY - 1):
+        assert _mmapped_bytes_of(large) >= large
