@@ -231,14 +231,14 @@ class Trainer:
             progress.stalled.copy_(torch.where(significant, 0, progress.stalled + 1))
             keep = progress.stalled < self._limit
             if self.start_patience is not None:
-                keep &= ~self._start_unbeaten(value)
+                keep &= ~self._start_unbeaten(value, self.start_patience)
             active.copy_(active & keep)
             self.epoch += 1
         self.optimiser.step()
 
-    def _start_unbeaten(self, value: torch.Tensor) -> torch.Tensor:
+    def _start_unbeaten(self, value: torch.Tensor, patience: int) -> torch.Tensor:
         """Update the start's bookkeeping with this epoch's losses; True for the groups
-        that ``start_patience`` stops now (no host-device synchronisation)."""
+        that ``start_patience=patience`` stops now (no host-device synchronisation)."""
         progress, tol = self.progress, self.tol
         first = self.epoch == 0
         start = progress.start_loss
@@ -250,7 +250,7 @@ class Trainer:
         low.copy_(torch.where(later, torch.minimum(low, value), low))
         progress.since_low.copy_(torch.where(fell, 0, progress.since_low + 1))
         falling = (progress.since_low < FALLING_EPOCHS) & (low <= NEAR_START * start)
-        waited = self.epoch + 1 >= self.start_patience
+        waited = self.epoch + 1 >= patience
         return waited & ~progress.beaten & ~falling
 
     def run(
