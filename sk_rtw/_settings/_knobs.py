@@ -205,9 +205,8 @@ KNOBS: dict[str, Knob] = {
         Knob(
             "start_patience",
             (*_integer(2), Constant(None, "no such stop")),
-            "Stop after this many epochs if none beat the first epoch's loss (the DTW "
-            "start's) by tol and the loss is not falling back towards it (a new low within "
-            "the last 4 epochs, at most twice the start's loss), keeping the start.",
+            "Stop after this many epochs if the lowest loss since the first epoch is still "
+            "more than twice the first epoch's (the DTW start's), keeping the start.",
             _every(None),
         ),
         Knob(
