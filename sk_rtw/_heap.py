@@ -14,7 +14,9 @@ fit (``M_MMAP_MAX = 0``, ``M_TRIM_THRESHOLD`` out of reach) and afterwards gives
 heap back to the system (``malloc_trim``) and leaves the allocator where its own adaptive
 rule ends for a program with large arrays (mmap threshold 32 MB, trim threshold 64 MB,
 mmap allowed again). Only fits whose temporaries exceed :data:`LARGE_TEMPORARY` bytes
-use it, and only where the C library is glibc; elsewhere it does nothing.
+use it, and only where the C library is glibc; elsewhere it does nothing. The settings are
+the process's: fits that overlap (threads of a grid search) share them, set by the first
+to start and given back by the last to finish.
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ import ctypes
 import ctypes.util
 import functools
 import sys
+import threading
 
 #: Bytes of one temporary from which a fit keeps its blocks in the heap.
 LARGE_TEMPORARY = 8 * 2**20
@@ -34,6 +37,9 @@ _M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD, _M_MMAP_MAX = -1, -3, -4
 #: the trim threshold twice it) and its default count of mmapped blocks.
 _MMAP_THRESHOLD_MAX = 32 * 2**20
 _MMAP_MAX = 65536
+#: Fits inside :func:`heap_for_temporaries` now, and the lock that guards the count.
+_holders = 0
+_lock = threading.Lock()
 
 
 @functools.cache
@@ -61,16 +67,23 @@ def heap_for_temporaries(temporary_bytes: float):
         Size of the fit's largest per-epoch temporary; below :data:`LARGE_TEMPORARY`, or
         without glibc, the block runs with the allocator as it is.
     """
+    global _holders
     libc = _glibc() if temporary_bytes >= LARGE_TEMPORARY else None
     if libc is None:
         yield
         return
-    libc.mallopt(_M_MMAP_MAX, 0)
-    libc.mallopt(_M_TRIM_THRESHOLD, 2**31 - 1)
+    with _lock:
+        if _holders == 0:
+            libc.mallopt(_M_MMAP_MAX, 0)
+            libc.mallopt(_M_TRIM_THRESHOLD, 2**31 - 1)
+        _holders += 1
     try:
         yield
     finally:
-        libc.mallopt(_M_MMAP_MAX, _MMAP_MAX)
-        libc.mallopt(_M_MMAP_THRESHOLD, _MMAP_THRESHOLD_MAX)
-        libc.mallopt(_M_TRIM_THRESHOLD, 2 * _MMAP_THRESHOLD_MAX)
-        libc.malloc_trim(0)
+        with _lock:
+            _holders -= 1
+            if _holders == 0:
+                libc.mallopt(_M_MMAP_MAX, _MMAP_MAX)
+                libc.mallopt(_M_MMAP_THRESHOLD, _MMAP_THRESHOLD_MAX)
+                libc.mallopt(_M_TRIM_THRESHOLD, 2 * _MMAP_THRESHOLD_MAX)
+                libc.malloc_trim(0)

@@ -48,3 +48,16 @@ def test_a_small_fit_leaves_the_allocator_alone():
     large = 128 * 2**20
     with heap_for_temporaries(LARGE_TEMPORARY - 1):
         assert _mmapped_bytes_of(large) >= large
+
+
+def test_overlapping_fits_keep_the_heap_until_the_last_one_ends():
+    """Two fits that overlap (threads of a grid search): the first to end leaves the
+    heap kept for the other; the last one gives the allocator back."""
+    large = 128 * 2**20
+    first, second = heap_for_temporaries(large), heap_for_temporaries(large)
+    first.__enter__()
+    second.__enter__()
+    first.__exit__(None, None, None)
+    assert _mmapped_bytes_of(large) == 0  # the second fit still runs
+    second.__exit__(None, None, None)
+    assert _mmapped_bytes_of(large) >= large
