@@ -6,15 +6,18 @@ glibc's ``malloc`` serves every block above its mmap threshold (at most 32 MB, a
 block of the size last freed is above it) with a fresh ``mmap`` and returns it with
 ``munmap`` when freed, so each temporary's pages are faulted in and zeroed again: a
 multiplication of two such tensors takes 3-5x the time it takes in reused memory
-(``benchmarks/heap_reuse.py``), and RTW's time per epoch grew 7.3x for 4x the length
-from 16,000 to 64,000 samples.
+(``benchmarks/heap_reuse.py``), and RTW's time per epoch grew 8.2x for 4x the length
+from 64,000 to 256,000 samples (2.4 to 19.2 s; 1.6 to 7.5 s, 4.8x, with the heap kept).
 
 :func:`heap_for_temporaries` keeps such blocks in the heap for the duration of a
 fit (``M_MMAP_MAX = 0``, ``M_TRIM_THRESHOLD`` out of reach) and afterwards gives the free
 heap back to the system (``malloc_trim``) and leaves the allocator where its own adaptive
 rule ends for a program with large arrays (mmap threshold 32 MB, trim threshold 64 MB,
 mmap allowed again). Only fits whose temporaries exceed :data:`LARGE_TEMPORARY` bytes
-use it, and only where the C library is glibc; elsewhere it does nothing. The settings are
+use it, and only where the C library is glibc; elsewhere it does nothing. Its price is
+memory: freed blocks of other sizes stay in the heap, and the peak of a 256,000-sample
+alignment of 8 quaternion series rose from 6.0 to 9.3 GB (the engine keeps the heap only
+where twice its estimated peak fits in the free memory). The settings are
 the process's: fits that overlap (threads of a grid search) share them, set by the first
 to start and given back by the last to finish.
 """

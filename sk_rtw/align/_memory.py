@@ -47,11 +47,12 @@ def network_memory(config: AlignmentConfig, n_series: int, n_groups: int = 1) ->
     return 8 * 4 * weights
 
 
-def check_memory(collection: SeriesCollection, config: AlignmentConfig, n_groups: int = 1) -> None:
-    """``MemoryError`` naming the sizes when an alignment cannot fit in memory."""
+def check_memory(collection: SeriesCollection, config: AlignmentConfig, n_groups: int = 1) -> int:
+    """``MemoryError`` naming the sizes when an alignment cannot fit in memory; else the
+    estimated bytes (:func:`estimated_memory`)."""
     need, free = estimated_memory(collection, config, n_groups), available_memory()
     if need <= free:
-        return
+        return need
     network = network_memory(config, collection.n_series, n_groups)
     if network > need / 2:
         raise MemoryError(
