@@ -61,3 +61,34 @@ def test_overlapping_fits_keep_the_heap_until_the_last_one_ends():
     assert _mmapped_bytes_of(large) == 0  # the second fit still runs
     second.__exit__(None, None, None)
     assert _mmapped_bytes_of(large) >= large
+
+
+def test_the_engine_keeps_the_heap_only_where_twice_its_estimate_fits(monkeypatch):
+    """The heap kept may hold about twice a fit's peak: with less free memory than twice
+    the estimate the fit leaves the allocator alone (asks for no kept heap)."""
+    import importlib
+
+    from sk_rtw import align
+
+    fit = importlib.import_module("sk_rtw.align._fit")
+    memory = importlib.import_module("sk_rtw.align._memory")
+    asked, estimates = [], []
+    estimate = memory.estimated_memory
+
+    def recorded_heap(nbytes):
+        asked.append(nbytes)
+        return heap_for_temporaries(0)
+
+    def recorded_estimate(*args, **kwargs):
+        estimates.append(estimate(*args, **kwargs))
+        return estimates[-1]
+
+    monkeypatch.setattr(fit, "heap_for_temporaries", recorded_heap)
+    monkeypatch.setattr(memory, "estimated_memory", recorded_estimate)
+    monkeypatch.setattr(memory, "available_memory", lambda: 2**40)
+    X = np.random.default_rng(0).standard_normal((4, 30)).cumsum(1)
+    for free_share in (3.0, 1.5):
+        monkeypatch.setattr(fit, "available_memory",
+                            lambda share=free_share: int(share * estimates[-1]))  # fmt: skip
+        align(X, n_epochs=1, random_state=0)
+    assert asked[0] == 4 * 120 * 8 and asked[1] == 0  # N Z doubles; none kept when tight
