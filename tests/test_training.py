@@ -214,7 +214,7 @@ def test_the_torch_floor_is_read_from_the_version():
     assert f'"torch>={MIN_TORCH[0]}.{MIN_TORCH[1]}"' in pyproject
 
 
-def _start_rule_reference(history, patience, near=2.0):
+def _start_rule_reference(history, patience, near=2.5):
     """Epochs a group runs under ``start_patience`` alone, written from its statement:
     after ``patience`` epochs, stop if the lowest loss since the first epoch is still
     more than ``near`` times the first epoch's."""
@@ -227,7 +227,7 @@ def _start_rule_reference(history, patience, near=2.0):
 # scripted losses (relative to the start's): the long demonstrations' far and slowly
 # falling climb-down; a short series' return that beats the start at epoch 8; one that
 # stays near the start (the no-change stop's case, not this rule's); one beaten at once;
-# one thrown far that comes back within twice the start's loss at epoch 4
+# one thrown far that comes back within 2.5 times the start's loss at epoch 4
 _SCRIPTS = {
     "far, falling": [1.0, 136.5, 26.0, 19.6, 22.3, 12.8, 4.1, 4.3, 2.2, 3.5, 3.1, 2.9, 2.2],
     "near, falling back": [1.0, 1.54, 1.06, 1.02, 1.1, 1.06, 1.01, 1.005, 0.97, 0.95, 0.96],
@@ -237,7 +237,7 @@ _SCRIPTS = {
 }
 
 
-@pytest.mark.parametrize("patience", [2, 3, 6])
+@pytest.mark.parametrize("patience", [2, 3, 6, 8])
 def test_start_patience_stops_each_group_as_the_rule_says(patience):
     """Five groups in one loop, each following a scripted loss: each runs the epochs
     the rule's plain statement gives it (no-change patience out of the way), keeps the
@@ -265,7 +265,7 @@ def test_start_patience_stops_each_group_as_the_rule_says(patience):
     far, back, stalled, beaten, back_at_4 = runs
     assert far == patience and back == stalled == beaten == n_epochs
     assert back_at_4 == (patience if patience <= 4 else n_epochs)
-    if patience == 6:  # what the rule is for: only the far group stops, keeping the start
+    if patience >= 6:  # what the rule is for: only the far group stops, keeping the start
         assert best[0] == 0 and list(runs[1:]) == [n_epochs] * 4
 
 
@@ -279,6 +279,6 @@ def test_the_start_rule_returns_the_start_where_training_cannot_beat_it():
     kept = align(X, manifold="quaternion", random_state=0)
     full = align(X, manifold="quaternion", random_state=0, start_patience=None)
     assert full.best_epoch == kept.best_epoch == 0
-    assert kept.n_iter == kept.config.start_patience == 6 and full.n_iter == 21
+    assert kept.n_iter == kept.config.start_patience == 8 and full.n_iter == 21
     np.testing.assert_array_equal(kept.warps, full.warps)
     np.testing.assert_allclose(kept.mean, full.mean, rtol=0, atol=1e-13)
