@@ -6,10 +6,11 @@ import json
 
 import numpy as np
 import pytest
-import torch
 
 from benchmarks import start_patience as bench
-from sk_rtw.align._training import NEAR_START, Trainer
+from sk_rtw.align._training import NEAR_START
+
+from .test_training import run_scripted
 
 # a fall back within 2.5 times at epoch 3; one far until epoch 9; one that beats the start
 _HISTORIES = [
@@ -21,19 +22,7 @@ _HISTORIES = [
 
 def _trainer_epochs(histories, patience):
     """Epochs each group runs in the trainer fed the scripted losses."""
-    scripts = [torch.tensor(h, dtype=torch.float64) for h in histories]
-    weight = torch.nn.Parameter(torch.zeros(len(scripts), 1, dtype=torch.float64))
-    epoch = [0]
-
-    def loss_fn():
-        values = torch.stack([s[epoch[0]] for s in scripts]) + 0.0 * weight[:, 0]
-        epoch[0] += 1
-        return values.sum(), values
-
-    trainer = Trainer(loss_fn, [weight], len(histories[0]), 0.1,
-                      parameter_groups=[torch.arange(len(scripts))], n_groups=len(scripts),
-                      n_iter_no_change=100, tol=1e-3, start_patience=patience)  # fmt: skip
-    trainer.run(lambda done, history: None, 50)
+    trainer, _ = run_scripted(histories, patience)
     return list(trainer.progress.epochs_run.numpy())
 
 

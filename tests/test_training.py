@@ -237,13 +237,10 @@ _SCRIPTS = {
 }
 
 
-@pytest.mark.parametrize("patience", [2, 3, 6, 8])
-def test_start_patience_stops_each_group_as_the_rule_says(patience):
-    """Five groups in one loop, each following a scripted loss: each runs the epochs
-    the rule's plain statement gives it (no-change patience out of the way), keeps the
-    start where it stopped, and its losses equal the script's."""
-    scripts = [torch.tensor(s, dtype=torch.float64) for s in _SCRIPTS.values()]
-    n_epochs = min(len(s) for s in scripts)
+def run_scripted(losses, start_patience):
+    """A trainer whose groups' losses follow the scripts ``losses`` (the no-change stop
+    out of the way), run for the shortest script's epochs: ``(trainer, best epochs)``."""
+    scripts = [torch.tensor(s, dtype=torch.float64) for s in losses]
     weight = torch.nn.Parameter(torch.zeros(len(scripts), 1, dtype=torch.float64))
     epoch = [0]
 
@@ -252,10 +249,20 @@ def test_start_patience_stops_each_group_as_the_rule_says(patience):
         epoch[0] += 1
         return values.sum(), values
 
-    trainer = Trainer(loss_fn, [weight], n_epochs, 0.1,
+    trainer = Trainer(loss_fn, [weight], min(len(s) for s in scripts), 0.1,
                       parameter_groups=[torch.arange(len(scripts))], n_groups=len(scripts),
-                      n_iter_no_change=100, tol=1e-3, start_patience=patience)  # fmt: skip
-    best = trainer.run(lambda done, history: None, 50)
+                      n_iter_no_change=100, tol=1e-3, start_patience=start_patience)  # fmt: skip
+    return trainer, trainer.run(lambda done, history: None, 50)
+
+
+@pytest.mark.parametrize("patience", [2, 3, 6, 8])
+def test_start_patience_stops_each_group_as_the_rule_says(patience):
+    """Five groups in one loop, each following a scripted loss: each runs the epochs
+    the rule's plain statement gives it (no-change patience out of the way), keeps the
+    start where it stopped, and its losses equal the script's."""
+    scripts = [torch.tensor(s, dtype=torch.float64) for s in _SCRIPTS.values()]
+    n_epochs = min(len(s) for s in scripts)
+    trainer, best = run_scripted(scripts, patience)
     runs = trainer.progress.epochs_run.numpy()
     expected = [_start_rule_reference(s[:n_epochs].numpy(), patience) for s in scripts]
     assert list(runs) == expected
