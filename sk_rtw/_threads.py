@@ -15,12 +15,18 @@ from __future__ import annotations
 
 import contextlib
 import os
+from collections.abc import Callable, Iterable
+from concurrent.futures import ThreadPoolExecutor
+from typing import TypeVar
 
 import numba
 import torch
 from joblib import effective_n_jobs
 
 from ._numba import check_n_jobs
+
+_Item = TypeVar("_Item")
+_Result = TypeVar("_Result")
 
 #: Elementwise work per epoch (points x taps) that one thread handles before a second
 #: one pays off.
@@ -68,3 +74,20 @@ def limited_threads(n_threads: int):
             torch.set_num_threads(torch_before)
         if numba.get_num_threads() != numba_before:
             numba.set_num_threads(numba_before)
+
+
+def thread_map(
+    function: Callable[[_Item], _Result], items: Iterable[_Item], n_threads: int
+) -> list[_Result]:
+    """``[function(item) for item in items]``, on up to ``n_threads`` Python threads.
+
+    For independent pieces of work that spend their time in this package's compiled
+    kernels (all ``nogil``) and in torch, which release the GIL; the results come back in
+    the order of ``items``. One thread (or one item) is a plain loop.
+    """
+    items = list(items)
+    workers = min(int(n_threads), len(items))
+    if workers <= 1:
+        return [function(item) for item in items]
+    with ThreadPoolExecutor(max_workers=workers) as pool:
+        return list(pool.map(function, items))

@@ -139,3 +139,24 @@ def test_threads_follow_n_jobs_and_the_problem_size(n_jobs, work, expected):
     from sk_rtw._threads import threads_for, usable_cores
 
     assert threads_for(n_jobs, work) == min(expected, usable_cores())
+
+
+def test_thread_map_keeps_the_order_and_runs_side_by_side():
+    """Two items that each wait for the other (a barrier of two) finish only if they run
+    at the same time; the results come back in the items' order; one thread is a plain
+    loop in the caller's thread."""
+    import threading
+
+    from sk_rtw._threads import thread_map
+
+    barrier = threading.Barrier(2, timeout=10)
+
+    def meet(item):
+        barrier.wait()  # BrokenBarrierError after 10 s if the other item is not running
+        return item * 10, threading.get_ident()
+
+    results = thread_map(meet, [1, 2], n_threads=2)
+    assert [value for value, _ in results] == [10, 20]
+    assert results[0][1] != results[1][1]
+    serial = thread_map(lambda item: (item, threading.get_ident()), range(5), n_threads=1)
+    assert serial == [(k, threading.get_ident()) for k in range(5)]

@@ -144,3 +144,30 @@ def test_the_dtw_starts_path_warps_are_those_of_each_pairs_path(manifold, window
             np.clip((smooth - smooth[0]) / (smooth[-1] - smooth[0]), 0.0, 1.0)
         )
         np.testing.assert_array_equal(_smooth_monotone(warp, sigma), smooth)
+
+
+def test_long_pairs_give_the_same_start_and_medoid_on_two_threads():
+    """Pairs solved coarse to fine one by one (8 x 4 = 32 times the series' length in
+    cells, over the exact limit) and the medoid's guide bounds run on threads when the fit
+    has several: the same starting warps bit for bit, and the same pairwise distances."""
+    from sk_rtw import dtw_pairwise_distance
+    from sk_rtw.align._layout import GroupLayout
+    from sk_rtw.align._start import dtw_start
+    from sk_rtw.dtw import solved_exactly
+    from sk_rtw.utils import check_series_collection
+
+    X = np.asarray(make_warped_signals("quaternion", 4, 1100, random_state=1).signals)
+    assert not solved_exactly(1100, 4 * 1100) and not solved_exactly(1100, 1100)
+    collection = check_series_collection(X, "quaternion")
+    layout = GroupLayout.from_codes(torch.zeros(4, dtype=torch.long))
+
+    def start(n_threads):
+        return dtw_start(collection, layout, 4 * 1100, 2,
+                         lambda warps: torch.as_tensor(np.repeat(X[:1], 4, axis=1)),
+                         [np.random.default_rng(0)], n_threads=n_threads)  # fmt: skip
+
+    np.testing.assert_array_equal(start(2), start(1))
+    np.testing.assert_array_equal(
+        dtw_pairwise_distance(X, manifold="quaternion", squared=True, n_jobs=2),
+        dtw_pairwise_distance(X, manifold="quaternion", squared=True, n_jobs=1),
+    )

@@ -94,7 +94,8 @@ def align_collection(
     # quaternion series of 256,000 samples): only where that fits in the free memory
     temporary = collection.n_series * output_length(config) * collection.data[0, 0].size * 8
     keep_heap = torch.device(config.device).type == "cpu" and 2 * need <= available_memory()
-    with limited_threads(threads_for(n_jobs, work)), heap_for_temporaries(keep_heap * temporary):
+    n_threads = threads_for(n_jobs, work)
+    with limited_threads(n_threads), heap_for_temporaries(keep_heap * temporary):
         model = build_warps(config, layout, torch_seeds).to(config.device)
         problem = Problem(collection, layout, config)
         if config.warp_start == "dtw" and layout.max_size > 1:
@@ -112,6 +113,7 @@ def align_collection(
                 smoothing=config.smoothing,
                 axis=config.start_axis,
                 window=config.dtw_window,
+                n_threads=n_threads,
             )
         if given_start is not None:
             problem.start = torch.as_tensor(given_start, dtype=torch.float64, device=config.device)

@@ -34,6 +34,7 @@ import numpy as np
 import torch
 
 from .._settings import START_AXES
+from .._threads import thread_map
 from ..dtw import (
     check_window,
     coarse_collection,
@@ -154,6 +155,7 @@ def reference_medoid(
     manifold: Manifold,
     rng: np.random.Generator,
     window: float | None = None,
+    n_threads: int = 1,
 ) -> np.ndarray:
     """The first reference: the DTW medoid of (at most :data:`MEDOID_CANDIDATES`) series.
 
@@ -172,7 +174,7 @@ def reference_medoid(
     while length > 16 and pairs * length**2 > MEDOID_CELLS:
         length = (length + 1) // 2
     collection = coarse_collection([series[i] for i in index], manifold, length)
-    return series[int(index[medoid_index(collection, window=window)])]
+    return series[int(index[medoid_index(collection, window=window, n_jobs=n_threads)])]
 
 
 #: DTW cells of the all-pairs medoid search beyond which the series are halved first.
@@ -189,6 +191,7 @@ def dtw_start(
     smoothing: float | None = None,
     axis: str = "average",
     window: float | None = None,
+    n_threads: int = 1,
 ) -> np.ndarray:
     """Starting warps ``(N, n_points)`` from DTW paths (see the module docstring).
 
@@ -215,6 +218,9 @@ def dtw_start(
     window : float in [0, 1] or None
         Sakoe-Chiba band of the medoid search and of the paths (None: no band; long
         pairs are then solved coarse to fine).
+    n_threads : int, default=1
+        Threads for the paths solved one by one (long pairs coarse to fine, or without
+        compiled costs); each path is the same on any number of threads.
 
     Returns
     -------
@@ -227,7 +233,7 @@ def dtw_start(
     series = [collection.series(i) for i in range(collection.n_series)]
     members = [layout.members(g) for g in range(layout.n_groups)]
     references = [
-        reference_medoid([series[i] for i in idx], manifold, rng, window)
+        reference_medoid([series[i] for i in idx], manifold, rng, window, n_threads)
         for idx, rng in zip(members, rngs, strict=True)
     ]
     # later references: the group mean at the output length
@@ -238,7 +244,8 @@ def dtw_start(
     along: list[np.ndarray] = []
     for round_ in range(rounds):
         previous = list(along)
-        along = _path_warps(references, series, stacked, codes, manifold, window, smoothing)
+        along = _path_warps(references, series, stacked, codes, manifold, window, smoothing,
+                            n_threads)  # fmt: skip
         if round_ == rounds - 1 or (
             round_ > 1 and all(np.array_equal(a, b) for a, b in zip(along, previous, strict=True))
         ):  # a fixed point: the next reference would be this one again
@@ -268,6 +275,7 @@ def _path_warps(
     manifold: Manifold,
     window: float | None,
     smoothing: float | None,
+    n_threads: int = 1,
 ) -> list[np.ndarray]:
     """:func:`path_warp` of every series' DTW path (squared costs) to the reference of
     its group: in a band if ``window`` is given, else coarse to fine for long pairs.
@@ -275,8 +283,8 @@ def _path_warps(
     The pairs whose path is exact (a band, or short enough for
     :func:`~sk_rtw.dtw.multiscale_path` to solve them exactly) go through one
     compiled pass (:func:`~sk_rtw.dtw.mean_matched_positions`: the same paths, no
-    Python per pair); the others one by one. ``stacked``: the same series as one padded
-    ``(N, T_max, p)`` array and their lengths.
+    Python per pair); the others one by one, on ``n_threads`` threads. ``stacked``: the
+    same series as one padded ``(N, T_max, p)`` array and their lengths.
     """
     band = check_window(window)
     compiled = has_compiled_costs(manifold)
@@ -298,13 +306,18 @@ def _path_warps(
         for row, n in enumerate(exact):
             length = len(references[codes[n]])
             warps[n] = position_warp(positions[row, :length], len(series[n]), smoothing)
-    for n in sorted(set(range(len(series))) - set(exact)):
+
+    def one_by_one(n: int) -> np.ndarray:
         reference = references[codes[n]]
         if window is None:
             path, _ = multiscale_path(reference, series[n], manifold, squared=True)
         else:
             path, _ = path_indices(reference, series[n], manifold, band, squared=True)
-        warps[n] = path_warp(path, len(reference), len(series[n]), smoothing)
+        return path_warp(path, len(reference), len(series[n]), smoothing)
+
+    rest = sorted(set(range(len(series))) - set(exact))
+    for n, warp in zip(rest, thread_map(one_by_one, rest, n_threads), strict=True):
+        warps[n] = warp
     return warps
 
 

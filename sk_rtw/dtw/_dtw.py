@@ -10,9 +10,11 @@ from __future__ import annotations
 
 from typing import Any
 
+import numba
 import numpy as np
 
 from .._numba import numba_threads
+from .._threads import thread_map
 from ..manifolds import Manifold
 from ..utils import SeriesCollection, check_series, check_series_collection
 from ..utils._common_params import DTW_WINDOW
@@ -57,9 +59,16 @@ def _guide_bounds(
     bounds = np.full((cx.n_series, cy.n_series), np.inf)
     if cx.max_length * cy.max_length <= EXACT_CELLS or 0.0 <= window < 1.0:
         return bounds  # no pair gets a guide: skip the loop
-    for i in range(cx.n_series):
-        for j in range(i + 1 if symmetric else 0, cy.n_series):
-            bounds[i, j] = guide_bound(cx.series(i), cy.series(j), cx.manifold, window, squared)
+    pairs = [(i, j) for i in range(cx.n_series)
+             for j in range(i + 1 if symmetric else 0, cy.n_series)]  # fmt: skip
+
+    def bound(pair: tuple[int, int]) -> float:
+        return guide_bound(cx.series(pair[0]), cy.series(pair[1]), cx.manifold, window, squared)
+
+    # on the threads the caller's n_jobs gave the kernels (numba_threads)
+    values = thread_map(bound, pairs, numba.get_num_threads())
+    for (i, j), value in zip(pairs, values, strict=True):
+        bounds[i, j] = value
     return bounds
 
 

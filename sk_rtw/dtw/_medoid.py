@@ -13,6 +13,7 @@ def medoid_index(
     candidates: np.ndarray | None = None,
     window: float | None = None,
     squared: bool = True,
+    n_jobs: int | None = None,
 ) -> int:
     """Index of the series with the smallest summed DTW cost to the others.
 
@@ -25,6 +26,8 @@ def medoid_index(
         Sakoe–Chiba band.
     squared : bool, default=True
         Squared geodesic point costs.
+    n_jobs : int, optional
+        Threads of the pairwise distances (:func:`dtw_pairwise_distance`).
 
     Returns
     -------
@@ -32,5 +35,6 @@ def medoid_index(
         Index into ``collection``.
     """
     index = np.arange(collection.n_series) if candidates is None else np.asarray(candidates)
-    D = dtw_pairwise_distance(collection.subset(index), window=window, squared=squared)
+    D = dtw_pairwise_distance(collection.subset(index), window=window, squared=squared,
+                              n_jobs=n_jobs)  # fmt: skip
     return int(index[np.argmin(D.sum(1))])
