@@ -58,6 +58,7 @@ RUN = r"""
 import json, resource, sys, time, os
 import numpy as np
 method, T, n, seed = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4])
+n_jobs = int(sys.argv[5])
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 import numba
 numba.set_num_threads(1)
@@ -75,7 +76,7 @@ if method == "rtw":
     from sk_rtw import align
     align(warm, manifold="quaternion", n_epochs=1)
     start = time.perf_counter()
-    result = align(X, manifold="quaternion", random_state=seed)
+    result = align(X, manifold="quaternion", random_state=seed, n_jobs=n_jobs)
     seconds, mean, iterations = time.perf_counter() - start, result.mean, result.n_iter
 elif method == "sk_rtw-dba":
     from sk_rtw.baselines import dba_average
@@ -129,7 +130,8 @@ def run_one(method: str, T: int, args) -> dict:
             import tslearn  # noqa: F401
         except ImportError:
             return {"status": "missing", "detail": "pip install tslearn"}
-    command = [sys.executable, "-c", RUN, method, str(T), str(args.n_series), str(args.seed)]
+    command = [sys.executable, "-c", RUN, method, str(T), str(args.n_series), str(args.seed),
+               str(args.n_jobs)]  # fmt: skip
     start = time.perf_counter()
     try:
         done = subprocess.run(command, capture_output=True, text=True, timeout=args.time_limit,
@@ -162,16 +164,28 @@ def cell(record: dict | None) -> str:
     return "error"
 
 
+def threads_note(args) -> str:
+    return f" (RTW: n_jobs={args.n_jobs})" if args.n_jobs > 1 else ""
+
+
+def record_name(method: str, T: int, args) -> str:
+    """The run's file: RTW's records name ``--n-jobs`` where it is not 1."""
+    jobs = f"-jobs{args.n_jobs}" if method == "rtw" and args.n_jobs > 1 else ""
+    return f"{method}-{T}-seed{args.seed}{jobs}.json"
+
+
 def markdown(results: dict, args) -> str:
     lines = [
         "# Long demonstrations",
         "",
         "N = 8 unit-quaternion series of T samples, each (method, T) alone in a fresh "
-        "process on one thread. A cell: fit seconds, peak memory of the process, quality "
-        "(path-normalised geodesic DTW of the mean to the clean trajectory, lower is "
-        "better; see the script's docstring).",
+        f"process on one thread{threads_note(args)}. A cell: fit seconds, peak memory of "
+        "the process, quality (path-normalised geodesic DTW of the mean to the clean "
+        "trajectory, lower is better; see the script's docstring).",
         "",
-        f"Command: `python benchmarks/long_demonstrations.py --seed {args.seed}`  ",
+        f"Command: `python benchmarks/long_demonstrations.py --seed {args.seed}"
+        + (f" --n-jobs {args.n_jobs}" if args.n_jobs > 1 else "")
+        + "`  ",
         f"Machine: {machine()}",
         "",
         "| T | " + " | ".join(args.methods) + " |",
@@ -215,6 +229,8 @@ def main(argv=None) -> None:
     parser.add_argument("--methods", nargs="+", choices=METHODS, default=list(METHODS))
     parser.add_argument("--n-series", type=positive_int, default=8)
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--n-jobs", type=positive_int, default=1,
+                        help="RTW's n_jobs (threads); the DBAs run on one thread")  # fmt: skip
     parser.add_argument("--time-limit", type=positive_int, default=1800,
                         help="seconds per run (default 30 min)")  # fmt: skip
     parser.add_argument("--out", default="results/long_demonstrations")
@@ -229,7 +245,7 @@ def main(argv=None) -> None:
     for method in args.methods:
         stopped = None
         for T in sorted(args.lengths):
-            key, file = f"{method}-{T}", out / f"{method}-{T}-seed{args.seed}.json"
+            key, file = f"{method}-{T}", out / record_name(method, T, args)
             if file.exists():
                 results[key] = json.loads(file.read_text())
             elif stopped is not None:
