@@ -214,8 +214,16 @@ def test_early_stopping_saves_epochs_and_keeps_the_best():
 
 
 def test_verbose_reports_progress(capsys):
-    align(np.random.default_rng(0).standard_normal((2, 10)), n_epochs=4, verbose=True)
-    assert "epoch" in capsys.readouterr().err
+    """Epochs, and the DTW start's medoid and rounds (on long series the start can take
+    longer than training); nothing without ``verbose``."""
+    X = np.random.default_rng(0).standard_normal((3, 10)).cumsum(1)
+    align(X, n_epochs=4, verbose=True, dtw_rounds=2)
+    err = capsys.readouterr().err
+    assert "epoch" in err and "[rtw] DTW start: 1 medoid(s) in" in err
+    assert "[rtw] DTW start: round 1/2, 3 paths in" in err
+    assert "[rtw] DTW start: round 2/2, 3 paths in" in err
+    align(X, n_epochs=4, dtw_rounds=2)
+    assert capsys.readouterr().err == ""
 
 
 def test_top_level_align_is_the_function_even_after_submodule_imports():

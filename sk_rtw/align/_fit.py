@@ -11,6 +11,7 @@ seed, best iterate and early stop).
 
 from __future__ import annotations
 
+import sys
 import time
 from typing import Any
 
@@ -114,6 +115,7 @@ def align_collection(
                 axis=config.start_axis,
                 window=config.dtw_window,
                 n_threads=n_threads,
+                report=_printer(config.method) if verbose else None,
             )
         if given_start is not None:
             problem.start = torch.as_tensor(given_start, dtype=torch.float64, device=config.device)
@@ -178,3 +180,12 @@ def _refined(problem: Problem, collection: SeriesCollection, layout: GroupLayout
     distances = manifold._dist(aligned, problem.layout.expand(refined))
     costs = problem.layout.sum((distances @ problem.loss_weights) * problem.series_weight)
     return refined, warps_t, aligned, costs.cpu().numpy()
+
+
+def _printer(method: str):
+    """A ``verbose`` line on standard error, tagged with the method (as the epochs')."""
+
+    def report(message: str) -> None:
+        print(f"[{method}] {message}", file=sys.stderr, flush=True)
+
+    return report

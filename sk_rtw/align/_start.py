@@ -28,6 +28,7 @@ composition of monotone maps, so the learned part keeps the paper's form and con
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
 
 import numpy as np
@@ -192,6 +193,7 @@ def dtw_start(
     axis: str = "average",
     window: float | None = None,
     n_threads: int = 1,
+    report: Callable[[str], None] | None = None,
 ) -> np.ndarray:
     """Starting warps ``(N, n_points)`` from DTW paths (see the module docstring).
 
@@ -221,6 +223,9 @@ def dtw_start(
     n_threads : int, default=1
         Threads for the paths solved one by one (long pairs coarse to fine, or without
         compiled costs); each path is the same on any number of threads.
+    report : callable, optional
+        Receives a line after the medoid and after each round (``verbose``: on long
+        series the start can take longer than training).
 
     Returns
     -------
@@ -232,10 +237,13 @@ def dtw_start(
     manifold = collection.manifold
     series = [collection.series(i) for i in range(collection.n_series)]
     members = [layout.members(g) for g in range(layout.n_groups)]
+    clock = time.perf_counter()
     references = [
         reference_medoid([series[i] for i in idx], manifold, rng, window, n_threads)
         for idx, rng in zip(members, rngs, strict=True)
     ]
+    if report is not None:
+        report(f"DTW start: {len(references)} medoid(s) in {time.perf_counter() - clock:.1f} s")
     # later references: the group mean at the output length
     ref_points = [n_points for _ in members]
     codes = layout.codes.cpu().numpy()
@@ -244,8 +252,12 @@ def dtw_start(
     along: list[np.ndarray] = []
     for round_ in range(rounds):
         previous = list(along)
+        clock = time.perf_counter()
         along = _path_warps(references, series, stacked, codes, manifold, window, smoothing,
                             n_threads)  # fmt: skip
+        if report is not None:
+            report(f"DTW start: round {round_ + 1}/{rounds}, {len(series)} paths in "
+                   f"{time.perf_counter() - clock:.1f} s")  # fmt: skip
         if round_ == rounds - 1 or (
             round_ > 1 and all(np.array_equal(a, b) for a, b in zip(along, previous, strict=True))
         ):  # a fixed point: the next reference would be this one again
