@@ -16,7 +16,7 @@ rule ends for a program with large arrays (mmap threshold 32 MB, trim threshold 
 mmap allowed again). Only fits whose temporaries exceed :data:`LARGE_TEMPORARY` bytes
 use it, and only where the C library is glibc; elsewhere it does nothing. Its price is
 memory: freed blocks of other sizes stay in the heap, and the peak of a 256,000-sample
-alignment of 8 quaternion series rose from 6.0 to 9.3 GB (the engine keeps the heap only
+alignment of 8 quaternion series rose from 6.0 to 9.3-9.9 GB (the engine keeps the heap only
 where twice its estimated peak fits in the free memory). The settings are
 the process's: fits that overlap (threads of a grid search) share them, set by the first
 to start and given back by the last to finish.

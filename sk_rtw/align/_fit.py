@@ -91,7 +91,7 @@ def align_collection(
         * (collection.max_length if config.sinc_window is None else 2 * config.sinc_window + 1)
     )
     # one (N, Z, point) float64 array: the size of most of an epoch's temporaries; the heap
-    # kept for them holds up to about twice the estimated peak (9.3 against 6.0 GB for 8
+    # kept for them holds up to about twice the estimated peak (9.3-9.9 against 6.0 GB for 8
     # quaternion series of 256,000 samples): only where that fits in the free memory
     temporary = collection.n_series * output_length(config) * collection.data[0, 0].size * 8
     keep_heap = torch.device(config.device).type == "cpu" and 2 * need <= available_memory()
