@@ -82,6 +82,8 @@ class SPD(Manifold):
         return s.expand_as(p), si.expand_as(p)
 
     def _group_log(self, means, codes, points):
+        if self.dim == 2 and _spd2.compiled(means, points):  # one compiled pass
+            return _spd2.log(group_expand(means, codes), points)
         if self.dim == 2:  # each mean's chart once, not once per member
             charts = _spd2.chart(means)
             return _spd2.log(_spd2.group_chart(charts, lambda f: group_expand(f, codes)), points)

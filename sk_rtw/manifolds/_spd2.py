@@ -14,15 +14,22 @@ series where ``r`` is small), so their gradients stay finite where the two eigen
 meet (``X = P``, ``V`` a multiple of ``P``). ``m`` and ``r^2`` come from the congruence
 ``L^-1 X L^-T`` (``P = L L^T``, Cholesky), a symmetric matrix with the eigenvalues of
 ``M``: ``r^2`` is a sum of squares there, free of cancellation.
+
+On the CPU in float64, :func:`log`, :func:`exp` and :func:`dist` run the same formulas
+compiled, with their gradients in closed form (:mod:`sk_rtw.manifolds._spd2_kernels`):
+one autograd node per call instead of some sixty elementwise ones. The torch formulas
+below are the path on other devices and dtypes, and the tests' reference.
 """
 
 from __future__ import annotations
 
 from typing import NamedTuple
 
+import numpy as np
 import torch
 
 from .._backend import safe_sqrt
+from . import _spd2_kernels as kernels
 from ._symmetric import distinct
 
 #: Below this ``r^2`` (``exp``) or ``(r / m)^2`` (``log``, distance) the even functions of
@@ -161,6 +168,12 @@ def _log_det_ratio(p: Chart, x) -> torch.Tensor:
 def log(p: torch.Tensor | Chart, x: torch.Tensor) -> torch.Tensor:
     """``Log_P(X)`` for SPD(2) points ``p`` (or their :class:`Chart`) and ``x`` (broadcast,
     ``(..., 2, 2)``)."""
+    if not isinstance(p, Chart) and compiled(p, x):
+        return _compiled_map("log", p, x)
+    return _torch_log(p, x)
+
+
+def _torch_log(p: torch.Tensor | Chart, x: torch.Tensor) -> torch.Tensor:
     base = p if isinstance(p, Chart) else chart(p)
     m, r2, entries = _congruence(base, x)
     mean_value, slope = _log_coefficients(m, r2, _log_det_ratio(base, entries))
@@ -169,6 +182,12 @@ def log(p: torch.Tensor | Chart, x: torch.Tensor) -> torch.Tensor:
 
 def exp(p: torch.Tensor, v: torch.Tensor) -> torch.Tensor:
     """``Exp_P(V)`` for an SPD(2) point ``p`` and a symmetric tangent vector ``v``."""
+    if compiled(p, v):
+        return _compiled_map("exp", p, v)
+    return _torch_exp(p, v)
+
+
+def _torch_exp(p: torch.Tensor, v: torch.Tensor) -> torch.Tensor:
     base = chart(p)
     m, r2, entries = _congruence(base, v)
     mean_value, slope = _exp_coefficients(m, r2)
@@ -189,4 +208,78 @@ def squared_dist(p: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
 
 def dist(p: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
     """Affine-invariant distance; its gradient at ``X = P`` is zero, not NaN."""
+    if compiled(p, x):
+        return _compiled_map("dist", p, x)
+    return _torch_dist(p, x)
+
+
+def _torch_dist(p: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
     return safe_sqrt(squared_dist(p, x))
+
+
+# ----------------------------------------------------------------- compiled (CPU, float64)
+def compiled(p: torch.Tensor | Chart, x: torch.Tensor) -> bool:
+    """Whether :func:`log`, :func:`exp` and :func:`dist` of these arguments run compiled:
+    point tensors (not a :class:`Chart`), both float64 on the CPU."""
+    return not isinstance(p, Chart) and all(
+        t.device.type == "cpu" and t.dtype == torch.float64 for t in (p, x)
+    )
+
+
+def _compiled_map(name: str, p: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
+    """``log``, ``exp`` (``(..., 2, 2)``) or ``dist`` (``(...)``) by the kernels; one
+    autograd node when a gradient is recorded (broadcasting is torch's, so its gradient
+    sums over the broadcast axes)."""
+    shape = torch.broadcast_shapes(p.shape, x.shape)
+    P = p.expand(shape).reshape(-1, 2, 2).contiguous()
+    X = x.expand(shape).reshape(-1, 2, 2).contiguous()
+    if torch.is_grad_enabled() and (P.requires_grad or X.requires_grad):
+        out = _KernelMap.apply(name, P, X)
+    else:
+        out, _ = _forward(name, P, X, save=False)
+    return out.reshape(shape[:-2] if name == "dist" else shape)
+
+
+def _forward(name: str, P: torch.Tensor, X: torch.Tensor, save: bool):
+    p, x = P.detach().numpy(), X.detach().numpy()
+    out = np.empty(p.shape[0]) if name == "dist" else np.empty_like(p)
+    saved = kernels.empty_saved(p.shape[0], save)
+    kernels.run(name, p, x, out, saved, save)
+    return torch.from_numpy(out), torch.from_numpy(saved)
+
+
+class _KernelMap(torch.autograd.Function):
+    """A compiled map of ``(n, 2, 2)`` matrices with its closed-form gradient."""
+
+    @staticmethod
+    def forward(ctx, name, P, X):
+        out, saved = _forward(name, P, X, save=True)
+        ctx.name = name
+        ctx.save_for_backward(P, X, saved)
+        return out
+
+    @staticmethod
+    def backward(ctx, grad):
+        P, X, saved = ctx.saved_tensors
+        if torch.is_grad_enabled():  # create_graph: a differentiable backward, the torch one
+            return None, *_torch_vjp(ctx.name, P, X, grad)
+        P, X = P.detach(), X.detach()
+        gp, gx = torch.empty_like(P), torch.empty_like(X)
+        g = grad.contiguous().numpy()
+        if ctx.name == "dist":
+            kernels.run("dist_backward", P.numpy(), X.numpy(), saved.numpy(), g, gp.numpy(),
+                        gx.numpy())  # fmt: skip
+        else:
+            kernels.run("map_backward", P.numpy(), X.numpy(), saved.numpy(), g, gp.numpy(),
+                        gx.numpy(), ctx.name == "exp")  # fmt: skip
+        return None, gp, gx
+
+
+_TORCH_MAPS = {"log": _torch_log, "exp": _torch_exp, "dist": _torch_dist}
+
+
+def _torch_vjp(name: str, P: torch.Tensor, X: torch.Tensor, grad: torch.Tensor):
+    """The gradients of the torch formulas, with their graph (higher derivatives)."""
+    inputs = [t for t in (P, X) if t.requires_grad]
+    grads = iter(torch.autograd.grad(_TORCH_MAPS[name](P, X), inputs, grad, create_graph=True))
+    return tuple(next(grads) if t.requires_grad else None for t in (P, X))
