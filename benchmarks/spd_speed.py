@@ -6,6 +6,7 @@ Usage::
     python benchmarks/spd_speed.py --sections dtw --repeats 5
     python benchmarks/spd_speed.py --sections rlasa --shared-data ../shared/data
     python benchmarks/spd_speed.py --sections eigh
+    python benchmarks/spd_speed.py --sections maps
 
 Prints, on one thread (torch's and numba's), the best of ``--repeats`` wall times (after
 a warm-up call) and their ratio to R^3 measured in the same run:
@@ -22,6 +23,13 @@ a warm-up call) and their ratio to R^3 measured in the same run:
     How many LAPACK eigendecompositions (``torch.linalg.eigh`` and ``eigvalsh`` calls and
     the matrices in them) one ``align`` (20 epochs) makes on N = 10 series of T = 100
     samples of SPD(8) and SPD(2), and its wall time (not part of the default run).
+``maps``
+    The SPD(2) maps one epoch of ``align`` runs -- ``Log``, ``Exp`` and the distance
+    between 3,000 matrices (30 series of 100 samples) and one base point per sample
+    broadcast over the series -- without and with their gradient: compiled
+    (``sk_rtw.manifolds._spd2_kernels``, the CPU float64 path) and as the torch formulas
+    (the path on other devices and dtypes, selected through the private switch
+    ``_spd2.compiled``), and their ratio (not part of the default run).
 ``rlasa``
     ``RTWNearestCentroid()`` (defaults) on R-LASA's 30 shapes (``--shared-data``), the
     first 3 demonstrations of each for training and the 4th for prediction, every 5th
@@ -29,7 +37,7 @@ a warm-up call) and their ratio to R^3 measured in the same run:
     prediction each (no repeats), and their ratio.
 
 Run it on an earlier commit (``PYTHONPATH`` set to that checkout) to compare before and
-after: every number comes from public calls.
+after: every number but the ``maps`` section's comes from public calls.
 """
 
 from __future__ import annotations
@@ -52,7 +60,7 @@ from sk_rtw import RTWNearestCentroid, align, dtw_pairwise_distance
 from sk_rtw.baselines import dba_average
 from sk_rtw.manifolds import SPD, Euclidean
 
-SECTIONS = ("dtw", "align", "rlasa", "eigh")
+SECTIONS = ("dtw", "align", "rlasa", "eigh", "maps")
 
 
 def smooth_series(manifold, n_series: int, length: int, seed: int = 0) -> np.ndarray:
@@ -153,6 +161,40 @@ def eigh_rows(n_series: int = 10, length: int = 100, n_epochs: int = 20) -> None
             setattr(torch.linalg, name, original)
 
 
+def map_rows(repeats: int, n_series: int = 30, length: int = 100) -> None:
+    from sk_rtw.manifolds import _spd2
+
+    print(f"\nSPD(2) maps on {n_series} x {length} matrices, base points broadcast over the "
+          "series: compiled / torch formulas")  # fmt: skip
+    manifold = SPD(2)
+    X = torch.as_tensor(smooth_series(manifold, n_series, length))
+    P = X[0:1].expand(n_series, -1, -1, -1)
+    with torch.no_grad():
+        V = _spd2.log(P, X)
+    compiled = _spd2.compiled
+    for name, function, argument in (("log", _spd2.log, X), ("exp", _spd2.exp, V),
+                                     ("dist", _spd2.dist, X)):  # fmt: skip
+        seconds = {}
+        for path in ("compiled", "torch"):
+            _spd2.compiled = compiled if path == "compiled" else (lambda p, x: False)
+            leaf = argument.clone().requires_grad_()
+
+            def value(f=function, argument=argument):
+                with torch.no_grad():
+                    f(P, argument)
+
+            def gradient(f=function, leaf=leaf):
+                f(P, leaf).sum().backward()
+
+            seconds[path] = [best_time(call, repeats * 10, warm_up=True)
+                             for call in (value, gradient)]  # fmt: skip
+        _spd2.compiled = compiled
+        (value_c, grad_c), (value_t, grad_t) = seconds["compiled"], seconds["torch"]
+        print(f"  {name:>4}: value {value_c * 1e6:6.0f} / {value_t * 1e6:6.0f} us "
+              f"({value_t / value_c:.1f}x faster), with its gradient {grad_c * 1e6:6.0f} / "
+              f"{grad_t * 1e6:6.0f} us ({grad_t / grad_c:.1f}x faster)", flush=True)  # fmt: skip
+
+
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(
         description=__doc__.splitlines()[0],
@@ -178,6 +220,8 @@ def main(argv=None) -> None:
             rlasa_rows(args.shared_data)
         if "eigh" in args.sections:
             eigh_rows()
+        if "maps" in args.sections:
+            map_rows(args.repeats)
     finally:
         torch.set_num_threads(threads[0])
         numba.set_num_threads(threads[1])

@@ -253,6 +253,19 @@ def test_the_spd_speed_benchmark_counts_eigendecompositions(capsys):
     assert torch.linalg.eigh is eigh and torch.get_num_threads() == threads
 
 
+def test_the_spd_speed_benchmark_times_both_paths_of_the_maps(capsys):
+    """The maps section: log, exp and dist, compiled against the torch formulas, with the
+    switch between them put back afterwards."""
+    from benchmarks import spd_speed
+    from sk_rtw.manifolds import _spd2
+
+    compiled = _spd2.compiled
+    spd_speed.map_rows(1, n_series=2, length=5)
+    rows = [line for line in capsys.readouterr().out.splitlines() if "faster" in line]
+    assert [row.split(":")[0].strip() for row in rows] == ["log", "exp", "dist"]
+    assert _spd2.compiled is compiled
+
+
 def test_manifold_classification_runs_one_fold(tmp_path):
     """R-LASA, one fold, a coarse step: every row scores, the page is written."""
     from benchmarks import manifold_classification
