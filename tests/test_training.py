@@ -127,6 +127,10 @@ def test_groups_in_one_batch_equal_separate_fits(method, dtype):
     seeds = [int(np.random.default_rng(s).integers(2**31 - 1)) for s in (11, 22)]
     batch = align_collection(collection, codes, seeds, config)
     tol = 1e-4 if dtype == "float32" else 1e-9
+    # each epoch's loss carries the float32 warps' rounding differences through the Adam
+    # steps before it; how far depends on the CPU's float32 kernels (1.5e-4 relative in
+    # one of 30 epochs on one machine, under 1e-4 on another)
+    loss_tol = 1e-3 if dtype == "float32" else tol
     for g, seed in enumerate((11, 22)):
         alone = align(
             [s for s, c in zip(series, codes, strict=True) if c == g], manifold="sphere",
@@ -135,7 +139,7 @@ def test_groups_in_one_batch_equal_separate_fits(method, dtype):
         assert batch[g].n_iter == alone.n_iter and batch[g].best_epoch == alone.best_epoch
         np.testing.assert_allclose(batch[g].warps, alone.warps, atol=tol)
         np.testing.assert_allclose(batch[g].mean, alone.mean, atol=tol)
-        np.testing.assert_allclose(batch[g].loss_history, alone.loss_history, rtol=tol)
+        np.testing.assert_allclose(batch[g].loss_history, alone.loss_history, rtol=loss_tol)
 
 
 @pytest.mark.parametrize(
@@ -166,12 +170,15 @@ def test_narrowing_the_batch_to_the_running_groups_changes_no_result(method, pre
     whole = align_collection(collection, codes, seeds, config)
     assert subsets, "the batch was never narrowed"
     assert len({r.n_iter for r in whole}) > 1  # the groups stopped at different epochs
+    # a float32 network's batched products may take another kernel for fewer groups on
+    # some CPUs (another blocking of the same sums): its last bits, 1e-9 in the warps
+    tol = 1e-7 if config.warp_dtype == "float32" else 1e-12
     for a, b in zip(narrowed, whole, strict=True):
         assert a.n_iter == b.n_iter and a.best_epoch == b.best_epoch
-        np.testing.assert_allclose(a.warps, b.warps, rtol=0, atol=1e-12)
-        np.testing.assert_allclose(a.mean, b.mean, rtol=0, atol=1e-12)
-        np.testing.assert_allclose(a.loss_history, b.loss_history, rtol=1e-12)
-        assert a.cost == pytest.approx(b.cost, rel=1e-12)
+        np.testing.assert_allclose(a.warps, b.warps, rtol=0, atol=tol)
+        np.testing.assert_allclose(a.mean, b.mean, rtol=0, atol=tol)
+        np.testing.assert_allclose(a.loss_history, b.loss_history, rtol=tol)
+        assert a.cost == pytest.approx(b.cost, rel=tol)
 
 
 def test_group_layout_sums_and_broadcasts():
