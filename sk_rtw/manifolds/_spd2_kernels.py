@@ -128,14 +128,23 @@ def _store(out, i, a, b, c):  # pragma: no cover
     out[i, 1, 1] = c
 
 
+@njit(inline="always", **_OPTIONS)
+def _log_terms(P, X, i):  # pragma: no cover
+    """What ``Log`` and the distance of pair ``i`` share: the entries (``xb`` deflated),
+    ``m``, ``q``, ``delta``, ``log(delta)``, ``B`` and ``B_q``."""
+    pa, pb, pc = _entries(P, i)
+    xa, xb, xc = _entries(X, i)
+    m, q, xb, det_p = _congruence(pa, pb, pc, xa, xb, xc)
+    delta = (xa * xc - xb * xb) / det_p
+    log_det = math.log(delta)
+    slope, slope_q = _log_slope(m, q, log_det, delta)
+    return (pa, pb, pc, xa, xb, xc), m, q, delta, log_det, slope, slope_q
+
+
 def _log_rows(P, X, out, saved, save):  # pragma: no cover
     for i in prange(P.shape[0]):
-        pa, pb, pc = _entries(P, i)
-        xa, xb, xc = _entries(X, i)
-        m, q, xb, det_p = _congruence(pa, pb, pc, xa, xb, xc)
-        delta = (xa * xc - xb * xb) / det_p
-        log_det = math.log(delta)
-        slope, slope_q = _log_slope(m, q, log_det, delta)
+        entries, m, _, delta, log_det, slope, slope_q = _log_terms(P, X, i)
+        pa, pb, pc, xa, xb, xc = entries
         a = 0.5 * log_det - slope * m
         _store(out, i, a * pa + slope * xa, a * pb + slope * xb, a * pc + slope * xc)
         if save:
@@ -160,13 +169,8 @@ def _exp_rows(P, V, out, saved, save):  # pragma: no cover
 def _dist_rows(P, X, out, saved, save):  # pragma: no cover
     """The distance; ``saved`` holds ``(d^2 / dm, d^2 / ddelta, m, delta, 1 / (2 d))``."""
     for i in prange(P.shape[0]):
-        pa, pb, pc = _entries(P, i)
-        xa, xb, xc = _entries(X, i)
-        m, q, xb, det_p = _congruence(pa, pb, pc, xa, xb, xc)
-        delta = (xa * xc - xb * xb) / det_p
-        log_det = math.log(delta)
+        _, m, q, delta, log_det, slope, slope_q = _log_terms(P, X, i)
         x = q / (m * m)
-        slope, slope_q = _log_slope(m, q, log_det, delta)
         if x < _SERIES_BELOW:
             ratio2 = x * (1.0 + x * (2.0 / 3.0 + x * 23.0 / 45.0))  # atanh(sqrt(x))^2
         else:
