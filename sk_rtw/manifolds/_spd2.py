@@ -23,7 +23,7 @@ below are the path on other devices and dtypes, and the tests' reference.
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import NamedTuple, TypeGuard
 
 import numpy as np
 import torch
@@ -168,7 +168,7 @@ def _log_det_ratio(p: Chart, x) -> torch.Tensor:
 def log(p: torch.Tensor | Chart, x: torch.Tensor) -> torch.Tensor:
     """``Log_P(X)`` for SPD(2) points ``p`` (or their :class:`Chart`) and ``x`` (broadcast,
     ``(..., 2, 2)``)."""
-    if not isinstance(p, Chart) and compiled(p, x):
+    if compiled(p, x):
         return _compiled_map("log", p, x)
     return _torch_log(p, x)
 
@@ -218,7 +218,7 @@ def _torch_dist(p: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
 
 
 # ----------------------------------------------------------------- compiled (CPU, float64)
-def compiled(p: torch.Tensor | Chart, x: torch.Tensor) -> bool:
+def compiled(p: torch.Tensor | Chart, x: torch.Tensor) -> TypeGuard[torch.Tensor]:
     """Whether :func:`log`, :func:`exp` and :func:`dist` of these arguments run compiled:
     point tensors (not a :class:`Chart`), both float64 on the CPU."""
     return not isinstance(p, Chart) and all(
