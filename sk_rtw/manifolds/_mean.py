@@ -170,10 +170,14 @@ def _iterate(manifold, points, codes, weights, mean, n_groups, steps, tol, warn)
         if not bool(running.any()):
             return mean
     if warn and steps > 0:
+        last = float(moved[running].max())
         warnings.warn(
-            f"the Fréchet mean did not converge in {steps} Gauss–Newton iterations (a step "
-            f"still above tol={tol:g}); raise max_iter or check that the samples are not "
-            "spread around the cut locus",
+            f"the Fréchet mean did not converge in {steps} Gauss–Newton iterations (the "
+            f"last step {last:.3g}, above tol={tol:g}): where that step is small, raise "
+            "max_iter; where it stays large, the samples lie too far apart for the full "
+            "Gauss–Newton step, which then cycles (points around a sphere's cut locus, "
+            "SPD matrices whose log-eigenvalues differ by several units): their mean is "
+            "not reliable",
             ConvergenceWarning,
             stacklevel=4,
         )
