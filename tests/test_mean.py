@@ -137,21 +137,60 @@ def test_one_warning_when_a_group_does_not_converge_and_none_for_a_fixed_budget(
         frechet_mean(S, torch.as_tensor(spread), max_iter=2, tol=0.0)
 
 
-def test_the_warning_tells_a_cycling_step_from_a_slow_one():
-    """Three SPD(6) matrices far apart (log-eigenvalues spread over 4.6-6.8 units within
-    each, in unrelated eigenbases): after 64 full Gauss–Newton steps the step is still
-    2.6; the warning gives that step and says the mean is not reliable."""
-    from sk_rtw.manifolds import SPD
-
+def _far_apart_spd6():
+    """Three SPD(6) matrices whose log-eigenvalues spread over 4.6-6.8 units, in unrelated
+    eigenbases: the full Gauss–Newton step still moves by 2.6 after 64 steps."""
     rng = np.random.default_rng(3)
     q, _ = np.linalg.qr(rng.standard_normal((3, 6, 6)))
-    points = (q * np.exp(rng.uniform(-6, 6, (3, 1, 6)))) @ np.swapaxes(q, 1, 2)
-    with pytest.warns(ConvergenceWarning, match=r"the last step (\d+\.?\d*).*cycles") as record:
-        SPD(6).mean(points, axis=0)
-    step = float(str(record[0].message).split("the last step ")[1].split(",")[0])
-    assert step > 1.0
-    with pytest.warns(ConvergenceWarning, match="raise max_iter"):  # slow, not cycling
-        Sphere(2).mean(Sphere(2).random_point(7, random_state=5), max_iter=2)
+    return (q * np.exp(rng.uniform(-6, 6, (3, 1, 6)))) @ np.swapaxes(q, 1, 2)
+
+
+def _karcher_reference(points, step=0.2, n_iter=400):
+    """The Karcher mean by short fixed steps (a contraction for these points), numpy."""
+
+    def function(S, f):
+        w, U = np.linalg.eigh(0.5 * (S + S.T))
+        return (U * f(w)) @ U.T
+
+    mean = points[0]
+    for _ in range(n_iter):
+        root, inverse = function(mean, np.sqrt), function(mean, lambda w: 1 / np.sqrt(w))
+        tangent = np.mean([function(inverse @ p @ inverse, np.log) for p in points], axis=0)
+        mean = root @ function(step * tangent, np.exp) @ root
+    return mean
+
+
+def test_far_apart_points_get_their_mean_where_the_full_step_cycles(monkeypatch):
+    from sk_rtw.manifolds import SPD, _mean
+
+    points = _far_apart_spd6()
+    calls = []
+    descend = _mean._descend
+    monkeypatch.setattr(_mean, "_descend", lambda *a: calls.append(1) or descend(*a))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        mean = np.asarray(SPD(6).mean(points, axis=0))
+    assert calls, "the full Gauss–Newton steps converged: the case tests nothing"
+    reference = _karcher_reference(points)
+    np.testing.assert_allclose(mean, reference, rtol=0, atol=1e-8 * np.abs(reference).max())
+    logs = np.asarray(SPD(6).log(np.broadcast_to(mean, points.shape), points))
+    assert np.abs(logs.mean(0)).max() < 1e-9  # the first-order condition
+
+
+def test_means_that_converge_never_take_the_line_searched_steps(monkeypatch):
+    from sk_rtw.manifolds import SPD, Quaternion, _mean
+
+    def refuse(*args):
+        raise AssertionError("a converging mean took the fallback")
+
+    monkeypatch.setattr(_mean, "_descend", refuse)
+    rng = np.random.default_rng(4)
+    for manifold in (SPD(3), Sphere(2), Quaternion()):
+        centre = manifold.random_point(1, random_state=rng)
+        steps = np.stack([manifold.random_tangent(centre[0], 0.3, random_state=rng)
+                          for _ in range(12)])  # fmt: skip
+        manifold.mean(np.asarray(manifold.exp(np.broadcast_to(centre, (12, *centre.shape[1:])),
+                                              steps)), axis=0)  # fmt: skip
 
 
 def test_bad_groups_weights_and_starts_are_named():

@@ -353,8 +353,11 @@ class Manifold(ABC):
         Each iteration maps the samples to the tangent space at the current estimate,
         averages them there (weighted) and maps the average back with ``exp``, from the
         first sample (of each group) or ``start``. A group stops when none of its means
-        moves by ``tol`` or more; one ``ConvergenceWarning`` if one is still moving after
-        ``max_iter`` iterations (``tol=0``: exactly ``max_iter``, no warning). The same
+        moves by ``tol`` or more. Where the full step cycles (samples far apart, such as
+        SPD matrices whose log-eigenvalues differ by several units), the means still
+        moving after ``max_iter`` iterations take up to ``max_iter`` line-searched
+        fractions of it; one ``ConvergenceWarning`` if one is still moving after those
+        (``tol=0``: exactly ``max_iter`` full steps, no fallback, no warning). The same
         kernel (:func:`sk_rtw.manifolds._mean.frechet_mean`) averages in the engine, DBA
         and the statistics.
 

@@ -12,9 +12,14 @@ On flat spaces one step is the exact weighted average.
 
 One stopping rule: a group stops when no mean of it moves by ``tol`` or more (geodesic
 distance of the step); with ``tol=0`` exactly ``max_iter`` steps are taken (a fixed
-budget, as DBA and the training loss use). A group still moving after ``max_iter`` steps
-raises one ``ConvergenceWarning``. Groups never interact: a group gets bitwise the same
-mean alone as in a batch (sums run in stacking order whatever the number of groups).
+budget, as DBA and the training loss use). The full Gauss–Newton step cycles where the
+points lie far apart (SPD matrices whose log-eigenvalues differ by several units): the
+means still moving after ``max_iter`` steps go on by at most ``max_iter`` line-searched
+steps (the best of a few fractions of the Gauss–Newton step, :func:`_descend`), which
+leaves every mean that converged as it was. A group still moving after those raises
+one ``ConvergenceWarning``. Groups never interact: a group gets bitwise the same
+mean alone as in a batch (sums run in stacking order whatever the number of groups; the
+fallback, which computes only the leading indices still moving, to rounding).
 
 Three ways to differentiate, for torch tensors: ``"all"`` keeps every step on the
 autograd graph; ``"last"`` runs all but the last step without gradient and
@@ -30,6 +35,7 @@ its DTW start, the returned means), DBA and the statistics of an aligned set all
 from __future__ import annotations
 
 import contextlib
+import math
 import warnings
 from typing import TYPE_CHECKING
 
@@ -120,7 +126,8 @@ def frechet_mean(
         Stop a group when its means move by less than this; 0: exactly ``max_iter`` steps.
     differentiate : {"all", "last", "none"}, default="all"
     warn : bool, default=True
-        ``ConvergenceWarning`` when a group is still moving after ``max_iter`` steps.
+        ``ConvergenceWarning`` when a group is still moving after ``max_iter`` steps and
+        as many line-searched ones (module docstring).
     sizes : torch.Tensor of int64, shape (n_groups,), optional
         Points per group, when known (saves a device synchronisation on a GPU).
 
@@ -155,33 +162,99 @@ def frechet_mean(
 
 
 def _iterate(manifold, points, codes, weights, mean, n_groups, steps, tol, warn):
-    """``steps`` Gauss–Newton steps; with ``tol > 0`` each group stops on its own."""
+    """``steps`` Gauss–Newton steps; with ``tol > 0`` each group stops on its own, and the
+    means still moving after them go on by :func:`_descend`."""
     if tol <= 0:
         for _ in range(steps):
             mean = _step(manifold, points, codes, weights, mean, n_groups)
         return mean
     running = torch.ones(n_groups, dtype=torch.bool, device=points.device)
     shape = (-1, *([1] * (mean.ndim - 1)))
+    moving = mean.new_zeros(0)
     for _ in range(steps):
         new = _step(manifold, points, codes, weights, mean, n_groups)
-        moved = manifold._dist(mean, new).reshape(n_groups, -1).amax(-1)
+        moving = manifold._dist(mean, new)
+        moved = moving.reshape(n_groups, -1).amax(-1)
         mean = torch.where(running.view(shape), new, mean)
         running = running & (moved >= tol)
         if not bool(running.any()):
             return mean
-    if warn and steps > 0:
-        last = float(moved[running].max())
+    if steps == 0:
+        return mean
+    failing = (moving >= tol) & running.view(shape[: moving.ndim])
+    mean, failing, last = _descend(manifold, points, codes, weights, mean, failing, n_groups,
+                                   steps, tol)  # fmt: skip
+    if warn and bool(failing.any()):
         warnings.warn(
-            f"the Fréchet mean did not converge in {steps} Gauss–Newton iterations (the "
-            f"last step {last:.3g}, above tol={tol:g}): where that step is small, raise "
-            "max_iter; where it stays large, the samples lie too far apart for the full "
-            "Gauss–Newton step, which then cycles (points around a sphere's cut locus, "
-            "SPD matrices whose log-eigenvalues differ by several units): their mean is "
-            "not reliable",
+            f"the Fréchet mean did not converge in {steps} Gauss–Newton iterations and "
+            f"{steps} line-searched steps (the last step {last:.3g}, above "
+            f"tol={tol:g}): raise max_iter, or check that the samples are not spread "
+            "around a sphere's cut locus",
             ConvergenceWarning,
             stacklevel=4,
         )
     return mean
+
+
+#: Fractions of the Gauss–Newton step :func:`_descend` tries, the best one taken if it
+#: shortens the next step.
+DESCENT_FRACTIONS = (1.0, 0.7, 0.5, 0.35, 0.25, 0.18, 0.125)
+
+
+def _gauss_newton(manifold, points, codes, w, mean, n_groups):
+    """The Gauss–Newton step of every mean (a tangent vector there) and its length
+    (``w``: the weights shaped to broadcast over the points)."""
+    direction = group_sum(w * manifold._group_log(mean, codes, points), codes, n_groups)
+    return direction, manifold._norm(mean, direction)
+
+
+def _descend(manifold, points, codes, weights, mean, failing, n_groups, steps, tol):
+    """At most ``steps`` line-searched steps of the means ``failing`` marks (n_groups,
+    *leading): of the fractions :data:`DESCENT_FRACTIONS` of the Gauss–Newton step, the
+    one after which the Gauss–Newton step (the gradient of the objective, resolved to
+    rounding where the objective itself is flat) is shortest. The full step overshoots
+    where the points lie far apart (it cycles: three SPD(6) matrices whose
+    log-eigenvalues spread over several units); a fraction of it converges. Where no
+    fraction shortens it, the fractions shrink by the smallest one. A mean stops, by the
+    main loop's rule, when the step it would take is shorter than ``tol``. Each step
+    computes only the leading indices where some mean still moves. Returns the means
+    (the others as they were), what is still moving and the longest step of those."""
+    nd = manifold.point_ndim
+    pad = (Ellipsis, *([None] * nd))
+    lead = mean.shape[1 : mean.ndim - nd]
+    width = math.prod(lead)
+    point_shape = mean.shape[mean.ndim - nd :]
+    # leading axes flattened into one: (N or n_groups, width, *point_shape)
+    points = points.reshape(points.shape[0], width, *point_shape)
+    weights = weights.reshape(weights.shape[0], width)
+    out = mean.reshape(n_groups, width, *point_shape).clone()
+    failing = failing.reshape(n_groups, width)
+    direction, length = _gauss_newton(manifold, points, codes, weights[pad], out, n_groups)
+    scale = torch.ones_like(length)
+    last = 0.0
+    for _ in range(steps):
+        failing = failing & (scale * length >= tol)
+        if not bool(failing.any()):
+            return out.reshape(mean.shape), failing.reshape(n_groups, *lead), 0.0
+        last = float((scale * length)[failing].max().detach())
+        cols = failing.any(0).nonzero().squeeze(1)
+        m, d, n, f = out[:, cols], direction[:, cols], length[:, cols], failing[:, cols]
+        x, w, c = points[:, cols], weights[:, cols][pad], scale[:, cols]
+        best, best_direction, shortest = m, d, n
+        for fraction in DESCENT_FRACTIONS:
+            candidate = manifold._exp(m, (fraction * c)[pad] * d)
+            new_direction, new_length = _gauss_newton(manifold, x, codes, w, candidate,
+                                                      n_groups)  # fmt: skip
+            better = new_length < shortest
+            best = torch.where(better[pad], candidate, best)
+            best_direction = torch.where(better[pad], new_direction, best_direction)
+            shortest = torch.where(better, new_length, shortest)
+        moves = f & (shortest < n)
+        out[:, cols] = torch.where(moves[pad], best, m)
+        direction[:, cols] = torch.where(moves[pad], best_direction, d)
+        length[:, cols] = torch.where(moves, shortest, n)
+        scale[:, cols] = torch.where(f & ~moves, DESCENT_FRACTIONS[-1] * c, c)
+    return out.reshape(mean.shape), failing.reshape(n_groups, *lead), last
 
 
 def checked_mean(
