@@ -89,10 +89,15 @@ def normalised_weights(
     return weights / group_expand(group_sum(weights, codes, n_groups), codes)
 
 
-def _step(manifold: Manifold, points, codes, weights, mean, n_groups):
+def _direction(manifold: Manifold, points, codes, weights, mean, n_groups):
+    """The Gauss–Newton step of every mean: the weighted average of the points' logs
+    there (``weights`` (N, *leading))."""
     w = weights.reshape(*weights.shape, *([1] * manifold.point_ndim))
-    logs = manifold._group_log(mean, codes, points)
-    return manifold._exp(mean, group_sum(w * logs, codes, n_groups))
+    return group_sum(w * manifold._group_log(mean, codes, points), codes, n_groups)
+
+
+def _step(manifold: Manifold, points, codes, weights, mean, n_groups):
+    return manifold._exp(mean, _direction(manifold, points, codes, weights, mean, n_groups))
 
 
 def frechet_mean(
@@ -201,10 +206,9 @@ def _iterate(manifold, points, codes, weights, mean, n_groups, steps, tol, warn)
 DESCENT_FRACTIONS = (1.0, 0.7, 0.5, 0.35, 0.25, 0.18, 0.125)
 
 
-def _gauss_newton(manifold, points, codes, w, mean, n_groups):
-    """The Gauss–Newton step of every mean (a tangent vector there) and its length
-    (``w``: the weights shaped to broadcast over the points)."""
-    direction = group_sum(w * manifold._group_log(mean, codes, points), codes, n_groups)
+def _gauss_newton(manifold, points, codes, weights, mean, n_groups):
+    """The Gauss–Newton step of every mean (:func:`_direction`) and its length."""
+    direction = _direction(manifold, points, codes, weights, mean, n_groups)
     return direction, manifold._norm(mean, direction)
 
 
@@ -229,7 +233,7 @@ def _descend(manifold, points, codes, weights, mean, failing, n_groups, steps, t
     weights = weights.reshape(weights.shape[0], width)
     out = mean.reshape(n_groups, width, *point_shape).clone()
     failing = failing.reshape(n_groups, width)
-    direction, length = _gauss_newton(manifold, points, codes, weights[pad], out, n_groups)
+    direction, length = _gauss_newton(manifold, points, codes, weights, out, n_groups)
     scale = torch.ones_like(length)
     last = 0.0
     for _ in range(steps):
@@ -239,7 +243,7 @@ def _descend(manifold, points, codes, weights, mean, failing, n_groups, steps, t
         last = float((scale * length)[failing].max().detach())
         cols = failing.any(0).nonzero().squeeze(1)
         m, d, n, f = out[:, cols], direction[:, cols], length[:, cols], failing[:, cols]
-        x, w, c = points[:, cols], weights[:, cols][pad], scale[:, cols]
+        x, w, c = points[:, cols], weights[:, cols], scale[:, cols]
         best, best_direction, shortest = m, d, n
         for fraction in DESCENT_FRACTIONS:
             candidate = manifold._exp(m, (fraction * c)[pad] * d)
