@@ -62,3 +62,15 @@ def numba_threads(n_jobs: int | None = -1):
             yield
         finally:
             numba.set_num_threads(previous)
+
+
+def launch(serial, parallel, work: int, threshold: int, *args) -> None:
+    """Run ``serial(*args)``, or ``parallel(*args)`` on the fit's threads (numba's current
+    count, set by :mod:`sk_rtw._threads`) when ``work`` reaches ``threshold`` and more than
+    one thread is allowed: the two builds of one kernel, threads only where they pay."""
+    threads = numba.get_num_threads()
+    if work < threshold or threads < 2:
+        serial(*args)
+        return
+    with numba_threads(threads):
+        parallel(*args)

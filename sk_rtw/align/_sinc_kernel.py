@@ -14,11 +14,10 @@ tap valid; ``window < 0``: the full sinc, taps ``j = 0..T_n - 1``, offset ``k = 
 
 from __future__ import annotations
 
-import numba
 import numpy as np
 from numba import njit, prange
 
-from .._numba import numba_threads
+from .._numba import launch
 
 
 def _window_sums(values, rows, base, frac, lengths, window, u, du):  # pragma: no cover
@@ -77,9 +76,5 @@ PARALLEL_TAPS = 2_000_000
 def window_sums(values, rows, base, frac, lengths, window, u, du) -> None:
     """Fill ``u`` and ``du`` (N, Z, D); see the module docstring for the layouts."""
     n_taps = frac.size * (values.shape[2] if window < 0 else 2 * window + 1)
-    threads = numba.get_num_threads()  # the fit's limit (sk_rtw._threads)
-    if n_taps < PARALLEL_TAPS or threads < 2:
-        window_sums_serial(values, rows, base, frac, lengths, window, u, du)
-        return
-    with numba_threads(threads):
-        window_sums_parallel(values, rows, base, frac, lengths, window, u, du)
+    launch(window_sums_serial, window_sums_parallel, n_taps, PARALLEL_TAPS,
+           values, rows, base, frac, lengths, window, u, du)  # fmt: skip

@@ -27,11 +27,10 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 from numba import njit, prange
 
-from .._numba import numba_threads
+from .._numba import launch
 
 _EPS = 2.220446049250313e-16
 #: The torch formulas' series threshold (values): below it the even functions of ``r``
@@ -254,12 +253,7 @@ def run(name: str, *arrays) -> None:
     """Launch kernel ``name`` on its arrays (rows first), threaded from
     :data:`PARALLEL_ROWS` rows when the fit allows more than one thread."""
     serial, parallel = _KERNELS[name]
-    threads = numba.get_num_threads()  # the fit's limit (sk_rtw._threads)
-    if arrays[0].shape[0] < PARALLEL_ROWS or threads < 2:
-        serial(*arrays)
-        return
-    with numba_threads(threads):
-        parallel(*arrays)
+    launch(serial, parallel, arrays[0].shape[0], PARALLEL_ROWS, *arrays)
 
 
 def empty_saved(n: int, save: bool) -> np.ndarray:
