@@ -162,37 +162,9 @@ def eigh_rows(n_series: int = 10, length: int = 100, n_epochs: int = 20) -> None
 
 
 def map_rows(repeats: int, n_series: int = 30, length: int = 100) -> None:
-    from sk_rtw.manifolds import _spd2
+    from benchmarks.manifold_maps import map_rows as manifold_map_rows
 
-    print(f"\nSPD(2) maps on {n_series} x {length} matrices, base points broadcast over the "
-          "series: compiled / torch formulas")  # fmt: skip
-    manifold = SPD(2)
-    X = torch.as_tensor(smooth_series(manifold, n_series, length))
-    P = X[0:1].expand(n_series, -1, -1, -1)
-    with torch.no_grad():
-        V = _spd2.log(P, X)
-    compiled = _spd2.compiled
-    for name, function, argument in (("log", _spd2.log, X), ("exp", _spd2.exp, V),
-                                     ("dist", _spd2.dist, X)):  # fmt: skip
-        seconds = {}
-        for path in ("compiled", "torch"):
-            _spd2.compiled = compiled if path == "compiled" else (lambda p, x: False)
-            leaf = argument.clone().requires_grad_()
-
-            def value(f=function, argument=argument):
-                with torch.no_grad():
-                    f(P, argument)
-
-            def gradient(f=function, leaf=leaf):
-                f(P, leaf).sum().backward()
-
-            seconds[path] = [best_time(call, repeats * 10, warm_up=True)
-                             for call in (value, gradient)]  # fmt: skip
-        _spd2.compiled = compiled
-        (value_c, grad_c), (value_t, grad_t) = seconds["compiled"], seconds["torch"]
-        print(f"  {name:>4}: value {value_c * 1e6:6.0f} / {value_t * 1e6:6.0f} us "
-              f"({value_t / value_c:.1f}x faster), with its gradient {grad_c * 1e6:6.0f} / "
-              f"{grad_t * 1e6:6.0f} us ({grad_t / grad_c:.1f}x faster)", flush=True)  # fmt: skip
+    manifold_map_rows("spd2", repeats, n_series, length)
 
 
 def main(argv=None) -> None:
@@ -225,6 +197,7 @@ def main(argv=None) -> None:
     finally:
         torch.set_num_threads(threads[0])
         numba.set_num_threads(threads[1])
+
 
 if __name__ == "__main__":
     main()

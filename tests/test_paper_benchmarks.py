@@ -253,17 +253,21 @@ def test_the_spd_speed_benchmark_counts_eigendecompositions(capsys):
     assert torch.linalg.eigh is eigh and torch.get_num_threads() == threads
 
 
-def test_the_spd_speed_benchmark_times_both_paths_of_the_maps(capsys):
-    """The maps section: log, exp and dist, compiled against the torch formulas, with the
-    switch between them put back afterwards."""
-    from benchmarks import spd_speed
-    from sk_rtw.manifolds import _spd2
+@pytest.mark.parametrize("manifold", ["sphere", "quaternion", "spd2"])
+def test_the_maps_benchmark_times_both_paths_of_the_maps(manifold, capsys):
+    """log, exp and dist, compiled against the torch formulas, with the switch between
+    them put back afterwards (the SPD speed benchmark's maps section is the spd2 row)."""
+    from benchmarks import manifold_maps, spd_speed
+    from sk_rtw.manifolds import _spd2, _sphere
 
-    compiled = _spd2.compiled
-    spd_speed.map_rows(1, n_series=2, length=5)
+    switches = _spd2.compiled, _sphere.compiled
+    if manifold == "spd2":
+        spd_speed.map_rows(1, n_series=2, length=5)
+    else:
+        manifold_maps.map_rows(manifold, 1, n_series=2, length=5)
     rows = [line for line in capsys.readouterr().out.splitlines() if "faster" in line]
     assert [row.split(":")[0].strip() for row in rows] == ["log", "exp", "dist"]
-    assert _spd2.compiled is compiled
+    assert (_spd2.compiled, _sphere.compiled) == switches
 
 
 def test_manifold_classification_runs_one_fold(tmp_path):

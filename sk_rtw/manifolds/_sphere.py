@@ -9,6 +9,7 @@ import numpy as np
 import torch
 
 from .._backend import inner, safe_norm
+from . import _sphere_kernels as kernels
 from ._base import Manifold
 from ._euclidean import _check_dim
 
@@ -18,6 +19,12 @@ _TAYLOR_SQ = 1e-12
 
 
 def _sphere_exp(p: torch.Tensor, v: torch.Tensor) -> torch.Tensor:
+    if compiled(p, v):
+        return _compiled_map("exp", p, v)
+    return _torch_exp(p, v)
+
+
+def _torch_exp(p: torch.Tensor, v: torch.Tensor, sign_invariant: bool = False) -> torch.Tensor:
     sq = inner(v, v, keepdim=True)
     small = sq < _TAYLOR_SQ
     safe_sq = torch.where(small, torch.ones_like(sq), sq)
@@ -35,7 +42,17 @@ def _antipodal_direction(p: torch.Tensor) -> torch.Tensor:
     return d / torch.sqrt(inner(d, d, keepdim=True))
 
 
-def _sphere_log(p: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
+def _sphere_log(p: torch.Tensor, x: torch.Tensor, sign_invariant: bool = False) -> torch.Tensor:
+    """``Log_p(x)``; ``sign_invariant``: of the representative of ``x`` in the hemisphere
+    of ``p`` (the quaternions')."""
+    if compiled(p, x):
+        return _compiled_map("log", p, x, sign_invariant)
+    return _torch_log(p, x, sign_invariant)
+
+
+def _torch_log(p: torch.Tensor, x: torch.Tensor, sign_invariant: bool = False) -> torch.Tensor:
+    if sign_invariant:
+        x = torch.where(inner(p, x, keepdim=True) < 0, -1.0, 1.0) * x
     c = inner(p, x, keepdim=True)
     u = x - c * p
     sq = inner(u, u, keepdim=True)
@@ -77,11 +94,78 @@ def _sphere_from_coordinates(p: torch.Tensor, c: torch.Tensor) -> torch.Tensor:
 
 
 def _sphere_dist(p: torch.Tensor, x: torch.Tensor, sign_invariant: bool = False) -> torch.Tensor:
+    if compiled(p, x):
+        return _compiled_map("dist", p, x, sign_invariant)
+    return _torch_dist(p, x, sign_invariant)
+
+
+def _torch_dist(p: torch.Tensor, x: torch.Tensor, sign_invariant: bool = False) -> torch.Tensor:
     c = inner(p, x)
     u = x - c.unsqueeze(-1) * p
     if sign_invariant:
         c = c.abs()
     return torch.atan2(safe_norm(u), c)
+
+
+# ----------------------------------------------------------------- compiled (CPU, float64)
+def compiled(p: torch.Tensor, x: torch.Tensor) -> bool:
+    """Whether the maps of these arguments run compiled (:mod:`._sphere_kernels`): both
+    float64 on the CPU."""
+    return all(t.device.type == "cpu" and t.dtype == torch.float64 for t in (p, x))
+
+
+def _compiled_map(name: str, p: torch.Tensor, x: torch.Tensor, sign_invariant: bool = False):
+    """``log``, ``exp`` (``(..., k)``) or ``dist`` (``(...)``) by the kernels; one autograd
+    node when a gradient is recorded (broadcasting is torch's, so its gradient sums over
+    the broadcast axes)."""
+    shape = torch.broadcast_shapes(p.shape, x.shape)
+    P = p.expand(shape).reshape(-1, shape[-1]).contiguous()
+    X = x.expand(shape).reshape(-1, shape[-1]).contiguous()
+    if torch.is_grad_enabled() and (P.requires_grad or X.requires_grad):
+        out = _KernelMap.apply(name, sign_invariant, P, X)
+    else:
+        out = _forward(name, P, X, sign_invariant)
+    return out.reshape(shape[:-1] if name == "dist" else shape)
+
+
+def _forward(name: str, P: torch.Tensor, X: torch.Tensor, sign_invariant: bool) -> torch.Tensor:
+    p, x = P.detach().numpy(), X.detach().numpy()
+    out = np.empty(p.shape[0]) if name == "dist" else np.empty_like(p)
+    kernels.run(name, p, x, out, *(() if name == "exp" else (sign_invariant,)))
+    return torch.from_numpy(out)
+
+
+class _KernelMap(torch.autograd.Function):
+    """A compiled sphere map of ``(n, k)`` rows with its closed-form gradient."""
+
+    @staticmethod
+    def forward(ctx, name, sign_invariant, P, X):
+        ctx.name, ctx.sign_invariant = name, sign_invariant
+        ctx.save_for_backward(P, X)
+        return _forward(name, P, X, sign_invariant)
+
+    @staticmethod
+    def backward(ctx, grad):
+        P, X = ctx.saved_tensors
+        if torch.is_grad_enabled():  # create_graph: a differentiable backward, the torch one
+            return None, None, *_torch_vjp(ctx.name, P, X, grad, ctx.sign_invariant)
+        P, X = P.detach(), X.detach()
+        gp, gx = torch.empty_like(P), torch.empty_like(X)
+        extra = () if ctx.name == "exp" else (ctx.sign_invariant,)
+        kernels.run(f"{ctx.name}_backward", P.numpy(), X.numpy(), grad.contiguous().numpy(),
+                    gp.numpy(), gx.numpy(), *extra)  # fmt: skip
+        return None, None, gp, gx
+
+
+_TORCH_MAPS = {"log": _torch_log, "exp": _torch_exp, "dist": _torch_dist}
+
+
+def _torch_vjp(name, P, X, grad, sign_invariant):
+    """The gradients of the torch formulas, with their graph (higher derivatives)."""
+    inputs = [t for t in (P, X) if t.requires_grad]
+    out = _TORCH_MAPS[name](P, X, sign_invariant)
+    grads = iter(torch.autograd.grad(out, inputs, grad, create_graph=True))
+    return tuple(next(grads) if t.requires_grad else None for t in (P, X))
 
 
 @dataclass(frozen=True)
@@ -199,8 +283,7 @@ class Quaternion(Sphere):
         return series
 
     def _log(self, p, x):
-        sign = torch.where(inner(p, x, keepdim=True) < 0, -1.0, 1.0)
-        return _sphere_log(p, sign * x)
+        return _sphere_log(p, x, sign_invariant=True)
 
     def _dist(self, p, x):
         return _sphere_dist(p, x, sign_invariant=True)
