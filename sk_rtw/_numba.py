@@ -74,3 +74,19 @@ def launch(serial, parallel, work: int, threshold: int, *args) -> None:
         return
     with numba_threads(threads):
         parallel(*args)
+
+
+def row_builds(functions: dict, **options) -> dict:
+    """Each kernel over rows (a ``prange`` loop) compiled twice, serial and threaded, by
+    name: what :func:`launch_rows` launches."""
+    return {
+        name: (numba.njit(**options)(function), numba.njit(**options, parallel=True)(function))
+        for name, function in functions.items()
+    }
+
+
+def launch_rows(builds: dict, name: str, threshold: int, *arrays) -> None:
+    """Launch kernel ``name`` of :func:`row_builds` on its arguments (row arrays first),
+    threaded from ``threshold`` rows (:func:`launch`)."""
+    serial, parallel = builds[name]
+    launch(serial, parallel, arrays[0].shape[0], threshold, *arrays)

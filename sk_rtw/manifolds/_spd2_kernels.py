@@ -30,7 +30,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from .._numba import launch
+from .._numba import launch_rows, row_builds
 
 _EPS = 2.220446049250313e-16
 #: The torch formulas' series threshold (values): below it the even functions of ``r``
@@ -236,24 +236,22 @@ def _dist_backward_rows(P, X, saved, grad, gp, gx):  # pragma: no cover
                (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), gp, gx)  # fmt: skip
 
 
-def _builds(function):
-    return njit(**_OPTIONS)(function), njit(**_OPTIONS, parallel=True)(function)
-
-
-_KERNELS = {
-    "log": _builds(_log_rows),
-    "exp": _builds(_exp_rows),
-    "dist": _builds(_dist_rows),
-    "map_backward": _builds(_map_backward_rows),
-    "dist_backward": _builds(_dist_backward_rows),
-}
+_KERNELS = row_builds(
+    {
+        "log": _log_rows,
+        "exp": _exp_rows,
+        "dist": _dist_rows,
+        "map_backward": _map_backward_rows,
+        "dist_backward": _dist_backward_rows,
+    },
+    **_OPTIONS,
+)
 
 
 def run(name: str, *arrays) -> None:
     """Launch kernel ``name`` on its arrays (rows first), threaded from
     :data:`PARALLEL_ROWS` rows when the fit allows more than one thread."""
-    serial, parallel = _KERNELS[name]
-    launch(serial, parallel, arrays[0].shape[0], PARALLEL_ROWS, *arrays)
+    launch_rows(_KERNELS, name, PARALLEL_ROWS, *arrays)
 
 
 def empty_saved(n: int, save: bool) -> np.ndarray:

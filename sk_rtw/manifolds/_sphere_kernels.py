@@ -26,7 +26,7 @@ import math
 
 from numba import njit, prange
 
-from .._numba import launch
+from .._numba import launch_rows, row_builds
 
 #: The torch formulas' series threshold on squared norms.
 _TAYLOR_SQ = 1e-12
@@ -203,22 +203,20 @@ def _dist_backward_rows(P, X, grad, gp, gx, sign_invariant):  # pragma: no cover
             gp[i, j] = -c * h + beta * X[i, j]
 
 
-def _builds(function):
-    return njit(**_OPTIONS)(function), njit(**_OPTIONS, parallel=True)(function)
-
-
-_KERNELS = {
-    "log": _builds(_log_rows),
-    "exp": _builds(_exp_rows),
-    "dist": _builds(_dist_rows),
-    "log_backward": _builds(_log_backward_rows),
-    "exp_backward": _builds(_exp_backward_rows),
-    "dist_backward": _builds(_dist_backward_rows),
-}
+_KERNELS = row_builds(
+    {
+        "log": _log_rows,
+        "exp": _exp_rows,
+        "dist": _dist_rows,
+        "log_backward": _log_backward_rows,
+        "exp_backward": _exp_backward_rows,
+        "dist_backward": _dist_backward_rows,
+    },
+    **_OPTIONS,
+)
 
 
 def run(name: str, *arrays) -> None:
     """Launch kernel ``name`` on its arguments (row arrays first), threaded from
     :data:`PARALLEL_ROWS` rows when the fit allows more than one thread."""
-    serial, parallel = _KERNELS[name]
-    launch(serial, parallel, arrays[0].shape[0], PARALLEL_ROWS, *arrays)
+    launch_rows(_KERNELS, name, PARALLEL_ROWS, *arrays)
