@@ -25,6 +25,7 @@ def _sphere_exp(p: torch.Tensor, v: torch.Tensor) -> torch.Tensor:
 
 
 def _torch_exp(p: torch.Tensor, v: torch.Tensor, sign_invariant: bool = False) -> torch.Tensor:
+    # sign_invariant: unused, the maps' common signature (:data:`_TORCH_MAPS`)
     sq = inner(v, v, keepdim=True)
     small = sq < _TAYLOR_SQ
     safe_sq = torch.where(small, torch.ones_like(sq), sq)
