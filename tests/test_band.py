@@ -158,3 +158,45 @@ def test_mean_matched_positions_are_the_paths_mean_positions(rng):
     with pytest.raises(ValueError, match="no compiled point costs"):
         mean_matched_positions(padded(references), np.array([30, 24]), padded(series),
                                np.array([28, 35, 19]), codes, SPD(13))  # fmt: skip
+
+
+@pytest.mark.parametrize("manifold", MANIFOLDS, ids=repr)
+@pytest.mark.parametrize("smooth", [True, False], ids=["smooth", "rough"])
+def test_exact_pairs_guided_by_a_coarse_path_equal_the_full_matrix(manifold, smooth, rng):
+    """The pairs multiscale_path solves exactly skip the cells a coarse-to-fine guide
+    rules out: the same path and cost, bit for bit, as the full matrix (smooth pairs,
+    where the guide prunes most cells, and rough ones, where it prunes few)."""
+    from sk_rtw.dtw import _band
+    from sk_rtw.dtw._costs import optimal_path, point_cost_matrix
+
+    if smooth:
+        p = manifold.random_point((), rng)
+        tangent = manifold.random_tangent(p, 1.0, random_state=2)
+
+        def curve(times):
+            return manifold.exp(
+                np.broadcast_to(p, (len(times), *p.shape)),
+                np.einsum("t,...->t...", np.sin(6 * times), tangent),
+            )
+
+        t = np.linspace(0, 1, 400)
+        x, y = curve(t), curve(np.linspace(0, 1, 330) ** 1.3)
+    else:
+        x, y = manifold.random_point((400,), rng), manifold.random_point((330,), rng)
+    assert len(x) * len(y) > _band.GUIDED_CELLS
+    for squared in (False, True):
+        path, cost = multiscale_path(x, y, manifold, squared=squared)
+        expected, expected_cost = optimal_path(point_cost_matrix(x, y, manifold, squared))
+        np.testing.assert_array_equal(path, expected)
+        assert cost == expected_cost
+
+
+def test_thin_exact_pairs_are_solved_on_the_full_matrix(monkeypatch, rng):
+    """A pair too thin for a band (one series of at most 2 radius + 2 samples) has no
+    coarser guide: the full matrix, without recursion."""
+    from sk_rtw.dtw import _band
+
+    monkeypatch.setattr(_band, "_guided_path", lambda *a: pytest.fail("guided a thin pair"))
+    x, y = smooth_walk(rng, 30, 2), smooth_walk(rng, 5000, 2)
+    path, _ = multiscale_path(x, y, Euclidean(2), squared=True)
+    assert path[-1].tolist() == [29, 4999]
