@@ -4,7 +4,8 @@ An exact DTW path between series of ``T_x`` and ``T_y`` samples costs ``T_x T_y`
 80 million for two robot demonstrations of 9,000 samples, and a dense accumulated-cost
 matrix of that size. :func:`multiscale_path` (Salvador and Chan's FastDTW, with the
 recursion of :mod:`sk_rtw.dtw._kernels`) halves both series by geodesic midpoints of
-neighbouring samples until they are short, solves the coarsest pair exactly, and at each
+neighbouring samples until they are short, solves the coarsest pair exactly (skipping,
+as the exact DTW does, the cells that cannot beat a still coarser path), and at each
 finer level only fills the cells within ``radius`` samples of the coarser path projected
 onto it: ``O((T_x + T_y) radius)`` cells per level. The path is optimal within the band;
 in the rare case that the optimal path leaves the band it is a close approximation
