@@ -199,10 +199,29 @@ def _guided_path(x, y, manifold, squared, radius):
     """The exact path of a pair :func:`multiscale_path` solves exactly, the cells that
     cannot beat a coarse-to-fine path (exact below :data:`GUIDE_EXACT_CELLS`) skipped:
     the same path and cost, bit for bit, as the full matrix's."""
-    from ._paths import path_indices  # _paths reads this module's guide_bound
-
     guide, _ = multiscale_path(x, y, manifold, squared, radius, GUIDE_EXACT_CELLS)
-    return path_indices(x, y, manifold, squared=squared, guide=guide)
+    bound = guide_bound(x, y, manifold, -1.0, squared, guide)
+    return bounded_path(x, y, manifold, -1.0, squared, bound)
+
+
+def bounded_path(
+    x: np.ndarray, y: np.ndarray, manifold: Manifold, window: float, squared: bool, bound: float
+) -> tuple[np.ndarray, float]:
+    """Optimal DTW path and cost of two validated series on a manifold with compiled point
+    costs, the cells that cannot beat ``bound`` skipped: the full matrix's path and cost,
+    bit for bit (a bound below the optimum only costs a second pass without it)."""
+    segments = _point_costs.segment_codes(manifold)
+    # the point costs are computed inside the accumulation (the T_x x T_y cost matrix is
+    # never stored) and only where a path could still beat the bound
+    fx, fy = kernel_form(x, manifold), kernel_form(y, manifold)
+    rows = _pruned.accumulated_segment_cost(fx, fy, segments, squared, window, bound)
+    cost = _pruned.ragged_value(*rows, len(x) - 1, len(y) - 1)
+    if not cost <= bound:  # the guide left the band, or a cost is not finite
+        rows = _pruned.accumulated_segment_cost(fx, fy, segments, squared, window, np.inf)
+        cost = _pruned.ragged_value(*rows, len(x) - 1, len(y) - 1)
+    if not np.isfinite(cost):  # the full cost matrix says why
+        return optimal_path(point_cost_matrix(x, y, manifold, squared), window)
+    return _pruned.ragged_backtrack(*rows, len(y)), float(cost)
 
 
 def guide_bound(

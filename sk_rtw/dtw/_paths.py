@@ -8,8 +8,8 @@ import numpy as np
 
 from ..manifolds import Manifold
 from . import _point_costs, _pruned
-from ._band import guide_bound
-from ._costs import kernel_form, optimal_path, point_cost_matrix
+from ._band import bounded_path, guide_bound
+from ._costs import optimal_path, point_cost_matrix
 
 
 def path_indices(
@@ -43,21 +43,10 @@ def path_indices(
     path : ndarray of shape (P, 2), int
     cost : float
     """
-    segments = _point_costs.segment_codes(manifold)
-    if segments is None:
+    if _point_costs.segment_codes(manifold) is None:
         return optimal_path(point_cost_matrix(x, y, manifold, squared), window)
-    # the point costs are computed inside the accumulation (the T_x x T_y cost matrix is
-    # never stored) and only where a path could still beat the guide's cost
-    fx, fy = kernel_form(x, manifold), kernel_form(y, manifold)
     bound = guide_bound(x, y, manifold, window, squared, guide)
-    rows = _pruned.accumulated_segment_cost(fx, fy, segments, squared, window, bound)
-    cost = _pruned.ragged_value(*rows, len(x) - 1, len(y) - 1)
-    if not cost <= bound:  # the guide left the band, or a cost is not finite
-        rows = _pruned.accumulated_segment_cost(fx, fy, segments, squared, window, np.inf)
-        cost = _pruned.ragged_value(*rows, len(x) - 1, len(y) - 1)
-    if not np.isfinite(cost):  # the full cost matrix says why
-        return optimal_path(point_cost_matrix(x, y, manifold, squared), window)
-    return _pruned.ragged_backtrack(*rows, len(y)), float(cost)
+    return bounded_path(x, y, manifold, window, squared, bound)
 
 
 def has_compiled_costs(manifold: Manifold) -> bool:
