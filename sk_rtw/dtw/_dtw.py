@@ -18,7 +18,7 @@ from .._threads import thread_map
 from ..manifolds import Manifold
 from ..utils import SeriesCollection, check_series, check_series_collection
 from ..utils._common_params import DTW_WINDOW
-from . import _kernels, _point_costs, _pruned
+from . import _kernels, _lanes, _point_costs, _pruned
 from ._band import EXACT_CELLS, guide_bound
 from ._costs import check_costs, kernel_form, point_cost_matrix
 from ._paths import path_indices
@@ -238,6 +238,29 @@ def dtw_pairwise_distance(
         return _pairwise(cx, cy, w, squared, symmetric, normalize == "path")
 
 
+def _in_lanes(flat_x, lx, flat_y, ly, segments, squared, window, symmetric) -> np.ndarray:
+    """:func:`~._pruned.pairwise_segments` without bounds, references of a common length
+    in the lanes of :mod:`._lanes` (the same values bit for bit), the others one pair at a
+    time."""
+    lx, ly = np.asarray(lx, dtype=np.int64), np.asarray(ly, dtype=np.int64)
+    values = np.zeros((flat_x.shape[0], flat_y.shape[0]))
+    (wide, narrow), single = _lanes.lane_blocks(ly)
+    for kernel, blocks in ((_lanes.pairwise_wide, wide), (_lanes.pairwise_narrow, narrow)):
+        if len(blocks):
+            kernel(flat_x, lx, flat_y, ly, segments, squared, window, blocks, symmetric, values)
+    if len(single):
+        rest = _pruned.pairwise_segments(
+            flat_x, lx, flat_y[single], ly[single], segments, squared, window, False,
+            np.full((flat_x.shape[0], len(single)), np.inf),
+        )  # fmt: skip
+        if symmetric:  # the upper triangle, as the one-pair kernel orients it
+            rest = np.where(single[None, :] > np.arange(flat_x.shape[0])[:, None], rest, 0.0)
+        values[:, single] = rest
+    if symmetric:
+        values = np.triu(values, 1) + np.triu(values, 1).T
+    return values
+
+
 def _pairwise(
     cx: SeriesCollection, cy: SeriesCollection, window, squared, symmetric, per_step
 ) -> np.ndarray:
@@ -250,6 +273,9 @@ def _pairwise(
         flat_y = _point_costs.kernel_series(cy)
         if not per_step:
             bounds = _guide_bounds(cx, cy, window, squared, symmetric)
+            if _lanes.lanes_apply(segments) and np.isinf(bounds).all():
+                return _in_lanes(flat_x, cx.lengths, flat_y, cy.lengths, segments, squared,
+                                 window, symmetric)  # fmt: skip
             return _pruned.pairwise_segments(
                 flat_x, cx.lengths, flat_y, cy.lengths, segments, squared, window, symmetric,
                 bounds,
