@@ -22,6 +22,21 @@ def one_pair_kernel(X, Y, manifold, window, squared):
     )  # fmt: skip
 
 
+@pytest.fixture
+def lane_calls(monkeypatch):
+    """Counts the blocks the lane kernels get, so a test knows the lanes ran."""
+    counts = {"blocks": 0}
+    for name in ("pairwise_wide", "pairwise_narrow"):
+        kernel = getattr(_lanes, name)
+
+        def counted(*args, kernel=kernel):
+            counts["blocks"] += len(args[7])
+            return kernel(*args)
+
+        monkeypatch.setattr(_lanes, name, counted)
+    return counts
+
+
 def series(rng, n, lengths, dim, scale=1.0):
     """``n`` random walks of lengths drawn from ``lengths``, (T,) or (T, dim) each."""
     shape = () if dim == 1 else (dim,)
@@ -35,7 +50,7 @@ def series(rng, n, lengths, dim, scale=1.0):
 @pytest.mark.parametrize("dim", [1, 3])
 @pytest.mark.parametrize("window", [None, 0.0, 0.1, 0.5])
 @pytest.mark.parametrize("squared", [False, True])
-def test_lanes_equal_the_one_pair_kernel(dim, window, squared, rng):
+def test_lanes_equal_the_one_pair_kernel(dim, window, squared, rng, lane_calls):
     X, Y = series(rng, 7, [40], dim), series(rng, 45, [40], dim)
     manifold = Euclidean(dim)
     got = dtw_pairwise_distance(X, Y, manifold, window=window, squared=squared)
@@ -44,10 +59,11 @@ def test_lanes_equal_the_one_pair_kernel(dim, window, squared, rng):
     got = dtw_pairwise_distance(Y, manifold=manifold, window=window, squared=squared)
     assert np.array_equal(got, one_pair_kernel(Y, None, manifold, window, squared))
     assert np.all(np.diag(got) == 0.0) and np.array_equal(got, got.T)
+    assert lane_calls["blocks"] > 0
 
 
 @pytest.mark.parametrize("symmetric", [False, True])
-def test_unequal_lengths_mix_lanes_and_single_pairs(symmetric, rng):
+def test_unequal_lengths_mix_lanes_and_single_pairs(symmetric, rng, lane_calls):
     # lengths shared by 40, 9, 3, 2 and 1 series: wide, narrow and one-pair references
     lengths = [20] * 40 + [25] * 9 + [31] * 3 + [12] * 2 + [17]
     Y = [np.cumsum(rng.standard_normal(t)) for t in rng.permutation(lengths)]
@@ -60,38 +76,44 @@ def test_unequal_lengths_mix_lanes_and_single_pairs(symmetric, rng):
         expected = one_pair_kernel(Y if symmetric else X, None if symmetric else Y,
                                    "euclidean", window, False)  # fmt: skip
         assert np.array_equal(got, expected)
+    assert lane_calls["blocks"] > 0
 
 
-def test_lanes_against_single_distances(rng):
+def test_lanes_against_single_distances(rng, lane_calls):
     """An independent check: every entry equals its own :func:`dtw_distance`."""
-    X, Y = series(rng, 3, [15, 18], 2), series(rng, 12, [16], 2)
+    X, Y = series(rng, 6, [15, 18], 2), series(rng, 12, [16], 2)
     got = dtw_pairwise_distance(X, Y, window=0.3)
     expected = [[dtw_distance(x, y, window=0.3) for y in Y] for x in X]
     np.testing.assert_allclose(got, expected, rtol=1e-13)
+    assert lane_calls["blocks"] > 0
 
 
 @pytest.mark.parametrize("scale", [1e-170, 1e170], ids=["tiny", "huge"])
-def test_extreme_magnitudes_take_the_robust_distance(scale, rng):
-    X, Y = series(rng, 3, [12], 2, scale), series(rng, 10, [12], 2, scale)
+def test_extreme_magnitudes_take_the_robust_distance(scale, rng, lane_calls):
+    X, Y = series(rng, 7, [12], 2, scale), series(rng, 10, [12], 2, scale)
     Y[4] = X[1].copy()  # coincident points: a zero sum of squares
     got = dtw_pairwise_distance(X, Y, window=0.5)
     assert np.array_equal(got, one_pair_kernel(X, Y, Euclidean(2), 0.5, False))
-    assert np.all(np.isfinite(got)) and np.all(got[[0, 2]] > 0) and got[1, 4] == 0.0
+    others = got[[0, 2, 3]]
+    assert np.all(np.isfinite(got)) and np.all(others > 0) and got[1, 4] == 0.0
     # the plain sum of squares would have under- or overflowed
-    assert np.all(got[[0, 2]] / scale < 1e3) and np.all(got[[0, 2]] / scale > 1e-3)
+    assert np.all(others / scale < 1e3) and np.all(others / scale > 1e-3)
+    assert lane_calls["blocks"] > 0
 
 
-def test_product_of_euclidean_spaces_sums_segments_in_order(rng):
+def test_product_of_euclidean_spaces_sums_segments_in_order(rng, lane_calls):
     manifold = Product([Euclidean(2), Euclidean(3)])
-    X, Y = series(rng, 4, [14], 5), series(rng, 11, [14], 5)
+    X, Y = series(rng, 6, [14], 5), series(rng, 11, [14], 5)
     got = dtw_pairwise_distance(X, Y, manifold, window=0.25)
     assert np.array_equal(got, one_pair_kernel(X, Y, manifold, 0.25, False))
+    assert lane_calls["blocks"] > 0
 
 
-def test_threads_give_the_serial_values(rng):
+def test_threads_give_the_serial_values(rng, lane_calls):
     Y = series(rng, 70, [30], 1)
     serial = dtw_pairwise_distance(Y, window=0.1, n_jobs=1)
     assert np.array_equal(dtw_pairwise_distance(Y, window=0.1, n_jobs=2), serial)
+    assert lane_calls["blocks"] > 0
 
 
 def test_lane_blocks_cover_every_reference_once():
@@ -108,6 +130,14 @@ def test_lane_blocks_cover_every_reference_once():
     assert set(lengths[single]) == {6, 8}
 
 
-def test_other_manifolds_keep_the_one_pair_kernel():
-    assert _lanes.lanes_apply(np.array([[0, 1, 0], [1, 4, 0]]))
-    assert not _lanes.lanes_apply(np.array([[0, 3, 0], [3, 7, 2]]))
+def test_other_manifolds_and_few_pairs_keep_the_one_pair_kernel(monkeypatch, rng):
+    many = _lanes.MIN_PAIRS
+    assert _lanes.lanes_apply(np.array([[0, 1, 0], [1, 4, 0]]), many)
+    assert not _lanes.lanes_apply(np.array([[0, 3, 0], [3, 7, 2]]), many)
+    assert not _lanes.lanes_apply(np.array([[0, 1, 0]]), many - 1)
+    # the pairs counted are those computed: a symmetric matrix of 12 series has 66
+    calls = []
+    monkeypatch.setattr(_dtw, "_in_lanes", lambda *a: calls.append(a) or np.zeros((12, 12)))
+    dtw_pairwise_distance(series(rng, 12, [20], 1))
+    dtw_pairwise_distance(series(rng, 11, [20], 1))  # 55 pairs
+    assert len(calls) == 1
