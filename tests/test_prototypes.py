@@ -120,26 +120,43 @@ def test_two_classes_weights_and_probabilities():
         _ = knn.readout_weights_
 
 
-def test_auto_decision_follows_the_cross_validated_scores():
+def _left_out_by_refits(clf, features, y):
+    """The default readout's classes for each series from a ridge refitted without it
+    (same scaling, the penalty the readout chose): leave-one-out by brute force."""
+    from sklearn.linear_model import RidgeClassifier
+
+    scaled = clf.readout_[0].transform(features)
+    alpha = clf.readout_[-1].alpha_
+    predicted = np.empty(len(y), dtype=int)
+    for i in range(len(y)):
+        rest = np.arange(len(y)) != i
+        ridge = RidgeClassifier(alpha=alpha).fit(scaled[rest], y[rest])
+        predicted[i] = ridge.predict(scaled[i : i + 1])[0]
+    return predicted
+
+
+@pytest.mark.parametrize("readout", [None, LogisticRegression()], ids=["default", "logistic"])
+def test_auto_decision_follows_the_cross_validated_scores(readout):
     """ "auto" keeps the nearest centroid unless the readout's cross-validated accuracy is
-    at least one standard error above it; the scores are recomputed here."""
+    at least one standard error above it; the scores are recomputed here: the default
+    readout's leave-one-out predictions by refits, another readout's on the folds."""
     from sklearn.base import clone as clone_estimator
 
     from sk_rtw.estimators._out_of_fold import split_folds
-    from sk_rtw.estimators._prototypes import default_readout
 
     X, y = three_shape_classes(n_per_class=10, seed=1)
     clf = RTWPrototypeClassifier(method=DBA(), n_centroids=2, dtw_window=0.1, cv=3,
-                                 random_state=0).fit(X, y)  # fmt: skip
+                                 readout=readout, random_state=0).fit(X, y)  # fmt: skip
     features = np.log1p(clf.oof_distances_ / clf.distance_scale_)
-    seed = np.random.RandomState(0).randint(2**31 - 1)
-    predicted = np.empty(len(y), dtype=int)
-    for train, test in split_folds(3, y, seed):
-        predicted[test] = (
-            clone_estimator(default_readout())
-            .fit(features[train], y[train])
-            .predict(features[test])
-        )
+    if readout is None:
+        predicted = _left_out_by_refits(clf, features, y)
+    else:
+        seed = np.random.RandomState(0).randint(2**31 - 1)
+        predicted = np.empty(len(y), dtype=int)
+        for train, test in split_folds(3, y, seed):
+            predicted[test] = (
+                clone_estimator(readout).fit(features[train], y[train]).predict(features[test])
+            )
     nearest = np.stack([clf.oof_distances_[:, clf.centroid_classes_ == c].min(1)
                         for c in range(3)], 1).argmin(1)  # fmt: skip
     scores = clf.cv_accuracy_

@@ -19,7 +19,7 @@ from ..utils._constraints import Constant, Interval, Options, Satisfies
 from ..utils._params import Parameter, declare_parameters, validate_parameters
 from ._averager import _check_labels, _encode
 from ._classifier import RTWNearestCentroid, fit_temperature
-from ._out_of_fold import out_of_fold_distances, split_folds
+from ._out_of_fold import out_of_fold_distances
 from ._params import (
     AVERAGER_DEFAULTS,
     AVERAGER_PARAMETERS,
@@ -27,6 +27,7 @@ from ._params import (
     set_params_with_hints,
     setting_hint,
 )
+from ._readout_cv import cross_validated_predictions
 from ._selection import Z_THRESHOLD, mcnemar
 
 if TYPE_CHECKING:
@@ -64,10 +65,12 @@ DECISION = Parameter(
     (Options(("auto", "readout", "nearest")),),
     '"readout": the readout classifies. "nearest": the nearest centroid does (the readout '
     'is still fitted, for its weights). "auto": the readout where, cross-validated on the '
-    "out-of-fold distances with the same folds, it classifies the training series better "
-    "than their nearest out-of-fold centroid by at least one standard error of the paired "
-    "difference (McNemar, the rule of the centroids' choice); the nearest centroid "
-    "otherwise.",
+    "out-of-fold distances, it classifies the training series better than their nearest "
+    "out-of-fold centroid by at least one standard error of the paired difference "
+    "(McNemar, the rule of the centroids' choice); the nearest centroid otherwise. The "
+    "default readout is cross-validated by its exact leave-one-out predictions (closed "
+    "form, no refit), any other readout by refits on the folds of the out-of-fold "
+    "distances.",
 )
 CV = Parameter(
     "cv",
@@ -284,10 +287,12 @@ class RTWPrototypeClassifier(ClassifierMixin, TransformerMixin, BaseEstimator):
         positive = distances[distances > 0]
         self.distance_scale_ = float(np.median(positive)) if len(positive) else 1.0
         features = self._features(distances)
-        self.decision_, self.cv_accuracy_ = self._decide(
-            params["decision"], readout, features, class_distances, codes, params["cv"], seed
-        )
+        unfitted = clone(readout)
         readout.fit(features, codes)
+        self.decision_, self.cv_accuracy_ = self._decide(
+            params["decision"], unfitted, readout, features, class_distances, codes,
+            params["cv"], seed,
+        )  # fmt: skip
         self.centroids_ = centroids
         self.readout_ = readout
         self.oof_distances_ = distances
@@ -300,19 +305,18 @@ class RTWPrototypeClassifier(ClassifierMixin, TransformerMixin, BaseEstimator):
             self.n_features_in_ = centroids.n_features_in_
         return self
 
-    def _decide(self, decision, readout, features, class_distances, codes, n_folds, seed):
-        """``decision_`` and the cross-validated accuracies behind it, on the folds of the
-        out-of-fold distances (drawn from ``seed`` as they were)."""
+    def _decide(self, decision, readout, fitted, features, class_distances, codes, n_folds,
+                seed):  # fmt: skip
+        """``decision_`` and the cross-validated accuracies behind it: the default
+        readout's leave-one-out predictions (closed form, from ``fitted``), any other
+        readout refitted on the folds of the out-of-fold distances (drawn from ``seed``
+        as they were)."""
         if decision != "auto":
             return decision, {}
-        predicted = np.empty_like(codes)
         fold_seed = check_random_state(seed).randint(2**31 - 1)
-        for train, test in split_folds(n_folds, codes, fold_seed):
-            if len(np.unique(codes[train])) < 2:  # a fold without a second class
-                predicted[test] = codes[train][0]
-                continue
-            fold_readout = clone(readout).fit(features[train], codes[train])
-            predicted[test] = fold_readout.predict(features[test])
+        predicted = cross_validated_predictions(
+            readout, fitted, features, codes, n_folds, fold_seed
+        )
         by_readout = predicted == codes
         by_nearest = class_distances.argmin(1) == codes
         z = mcnemar(by_readout, by_nearest)

@@ -1,0 +1,168 @@
+"""The prototype classifier's decision rule: leave-one-out against refits on folds, one fit.
+
+Usage::
+
+    python benchmarks/ucr/prototype_decision.py --data-dir ../shared/ucr --halves A B \\
+        --seeds 0 1 2 --out results/decision_dev.jsonl
+    python benchmarks/ucr/prototype_decision.py --data-dir ../shared/ucr_large \\
+        --halves C1 C2 --seeds 0 --out results/decision_large.jsonl
+
+For every dataset and seed, on one thread (BLAS included): ``RTWNearestCentroid()`` and
+``RTWPrototypeClassifier()`` fitted and timed (fit, prediction of the test set), then,
+from the prototype fit's own out-of-fold distances, the decision of ``decision="auto"``
+by both rules: the default readout's closed-form leave-one-out predictions (the
+classifier's rule) and the rule it replaced, five readouts refitted on the folds of the
+out-of-fold distances. Test accuracy under each rule (the readout's and the nearest
+centroid's predictions are both computed). Each dataset's record is appended to
+``--out`` as it finishes (JSON lines; a rerun skips what is there), then the summary per
+half and seed is printed: mean accuracy of the nearest centroid and of both rules, the
+datasets where the rules decide differently, and the fit and prediction of the
+prototype classifier against the nearest centroid's.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+from sklearn.base import clone
+from sklearn.utils import check_random_state
+from threadpoolctl import threadpool_limits
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the repository; then _shared
+
+from benchmarks._shared import machine
+from benchmarks.ucr._data import load_split
+from benchmarks.ucr._summary import FIXED_HALVES
+from sk_rtw import RTWNearestCentroid, RTWPrototypeClassifier
+from sk_rtw.estimators._out_of_fold import split_folds
+from sk_rtw.estimators._prototypes import default_readout
+from sk_rtw.estimators._selection import Z_THRESHOLD, mcnemar
+
+
+def refitted_on_folds(clf: RTWPrototypeClassifier, features, codes, seed: int) -> np.ndarray:
+    """The former rule's predictions: the default readout refitted on the folds."""
+    predicted = np.empty_like(codes)
+    fold_seed = check_random_state(seed).randint(2**31 - 1)
+    for train, test in split_folds(clf.cv, codes, fold_seed):
+        if len(np.unique(codes[train])) < 2:
+            predicted[test] = codes[train][0]
+            continue
+        readout = clone(default_readout()).fit(features[train], codes[train])
+        predicted[test] = readout.predict(features[test])
+    return predicted
+
+
+def measure(name: str, seed: int, data_dir: str) -> dict:
+    train, test = load_split(name, "train", data_dir), load_split(name, "test", data_dir)
+    start = time.perf_counter()
+    nearest = RTWNearestCentroid(random_state=seed, n_jobs=1).fit(train.X, train.y)
+    nc_fit = time.perf_counter() - start
+    start = time.perf_counter()
+    nc_predicted = nearest.predict(test.X)
+    nc_predict = time.perf_counter() - start
+    start = time.perf_counter()
+    clf = RTWPrototypeClassifier(random_state=seed, n_jobs=1).fit(train.X, train.y)
+    fit = time.perf_counter() - start
+    start = time.perf_counter()
+    predicted = clf.predict(test.X)
+    predict = time.perf_counter() - start
+
+    codes = np.searchsorted(clf.classes_, train.y)
+    features = clf._features(clf.oof_distances_)
+    by_class = np.stack(
+        [clf.oof_distances_[:, clf.centroid_classes_ == c].min(1)
+         for c in range(len(clf.classes_))], axis=1,
+    )  # fmt: skip
+    z_folds = float(mcnemar(refitted_on_folds(clf, features, codes, seed) == codes,
+                            by_class.argmin(1) == codes))  # fmt: skip
+    folds_decision = "readout" if z_folds >= Z_THRESHOLD else "nearest"
+    test_features = clf._features(clf.transform(test.X))
+    by_readout = clf.classes_[np.asarray(clf.readout_.predict(test_features), dtype=np.int64)]
+    by_nearest = clf.centroids_.predict(test.X)
+
+    def accuracy(labels) -> float:
+        return float(np.mean(labels == test.y))
+
+    half = next((h for h, members in FIXED_HALVES.items() if name in members), "-")
+    return {
+        "dataset": name, "seed": seed, "half": half, "n_means": len(clf.centroid_classes_),
+        "nearest_centroid": accuracy(nc_predicted), "prototype": accuracy(predicted),
+        "decision": clf.decision_, "z": clf.cv_accuracy_["z"],
+        "folds_decision": folds_decision, "folds_z": z_folds,
+        "folds_rule": accuracy(by_readout if folds_decision == "readout" else by_nearest),
+        "readout": accuracy(by_readout), "nearest": accuracy(by_nearest),
+        "nc_fit": nc_fit, "nc_predict": nc_predict, "fit": fit, "predict": predict,
+    }  # fmt: skip
+
+
+def summary(records: list[dict]) -> None:
+    groups: dict[tuple[str, int], list[dict]] = defaultdict(list)
+    for record in records:
+        groups[(record["half"], record["seed"])].append(record)
+    print("| half | seed | sets | nearest centroid | leave-one-out rule | folds rule | "
+          "fit / NC fit | predict / NC predict |")  # fmt: skip
+    print("| --- | --- | --- | --- | --- | --- | --- | --- |")
+    for (half, seed), rows in sorted(groups.items()):
+
+        def mean(key: str, rows=rows) -> float:
+            return float(np.mean([r[key] for r in rows]))
+
+        def ratio(key: str, base: str, rows=rows) -> float:
+            return sum(r[key] for r in rows) / sum(r[base] for r in rows)
+
+        print(
+            f"| {half} | {seed} | {len(rows)} | {mean('nearest_centroid'):.4f} | "
+            f"{mean('prototype'):.4f} | {mean('folds_rule'):.4f} | "
+            f"{ratio('fit', 'nc_fit'):.2f} ({sum(r['fit'] for r in rows):.1f} s) | "
+            f"{ratio('predict', 'nc_predict'):.2f} |"
+        )
+    print("\nWhere the rules differ or the readout decides:")
+    for r in records:
+        if r["decision"] != r["folds_decision"] or r["decision"] == "readout":
+            print(
+                f"- {r['dataset']} seed {r['seed']}: leave-one-out {r['decision']} "
+                f"(z = {r['z']:.2f}, {r['prototype']:.4f}), folds {r['folds_decision']} "
+                f"(z = {r['folds_z']:.2f}, {r['folds_rule']:.4f}); fit {r['fit']:.1f} s "
+                f"against {r['nc_fit']:.1f} s"
+            )
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--data-dir", required=True)
+    parser.add_argument("--halves", nargs="+", default=["A", "B"], choices=list(FIXED_HALVES))
+    parser.add_argument("--seeds", nargs="+", type=int, default=[0])
+    parser.add_argument("--out", type=Path, required=True)
+    args = parser.parse_args(argv)
+    print(f"machine: {machine()}; one thread", flush=True)
+    records = []
+    if args.out.exists():
+        records = [json.loads(line) for line in args.out.read_text().splitlines()]
+    done = {(r["dataset"], r["seed"]) for r in records}
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    with threadpool_limits(1):
+        for seed in args.seeds:
+            for half in args.halves:
+                for name in FIXED_HALVES[half]:
+                    if (name, seed) in done:
+                        continue
+                    record = measure(name, seed, args.data_dir)
+                    records.append(record)
+                    with args.out.open("a") as handle:
+                        handle.write(json.dumps(record) + "\n")
+                    print(
+                        f"{name} seed {seed}: {record['decision']} "
+                        f"({record['prototype']:.4f}), fit {record['fit']:.1f} s",
+                        flush=True,
+                    )
+    summary([r for r in records if r["seed"] in args.seeds])
+
+
+if __name__ == "__main__":
+    main()
