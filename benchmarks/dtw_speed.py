@@ -3,11 +3,13 @@
 Usage::
 
     python benchmarks/dtw_speed.py [--n-series 200] [--length 256] [--jobs 1 2] [--repeats 3]
+                                   [--windows none 0.1]
 
-Prints, for 200 x 200 pairs of series of length 256 (by default), the best-of-``repeats``
-wall time of sk_rtw (Euclidean manifold, squared point cost as in aeon, so the values are
-identical) and of aeon, their ratio (target: sk_rtw / aeon <= 1.5), and the time of the
-same call with the geodesic (unsquared) cost and on the S^1 manifold for reference.
+Prints, for 200 x 200 pairs of series of length 256 (by default), with no band and with
+a Sakoe-Chiba band of radius 0.1, the best-of-``repeats`` wall time of sk_rtw (Euclidean
+manifold, squared point cost as in aeon, so the values are identical) and of aeon, their
+ratio (target: sk_rtw / aeon <= 1.5), and the time of the same call with the geodesic
+(unsquared) cost and on the S^1 manifold for reference.
 """
 
 from __future__ import annotations
@@ -32,6 +34,8 @@ def main(argv=None) -> None:
     parser.add_argument("--length", type=int, default=256)
     parser.add_argument("--jobs", type=int, nargs="+", default=[1, 2])
     parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--windows", nargs="+", default=["none", "0.1"],
+                        help="Sakoe-Chiba radii ('none': no band)")  # fmt: skip
     args = parser.parse_args(argv)
 
     rng = np.random.default_rng(0)
@@ -55,22 +59,33 @@ def main(argv=None) -> None:
         f"best of {args.repeats}"
     )
     print(
-        f"{'n_jobs':>6} {'sk_rtw [s]':>11} {'aeon [s]':>9} {'ratio':>6} "
+        f"{'window':>6} {'n_jobs':>6} {'sk_rtw [s]':>11} {'aeon [s]':>9} {'ratio':>6} "
         f"{'geodesic [s]':>13} {'S^1 [s]':>8}"
     )
-    for n_jobs in args.jobs:
-        ours = best_time(
-            lambda j=n_jobs: dtw_pairwise_distance(X, Y, squared=True, n_jobs=j), args.repeats
-        )
-        theirs = best_time(lambda j=n_jobs: aeon_pairwise(X, Y, n_jobs=j), args.repeats)
-        geodesic = best_time(lambda j=n_jobs: dtw_pairwise_distance(X, Y, n_jobs=j), 1)
-        sphere = best_time(
-            lambda j=n_jobs: dtw_pairwise_distance(circle[0], circle[1], "sphere", n_jobs=j), 1
-        )
-        print(
-            f"{n_jobs:>6} {ours:>11.3f} {theirs:>9.3f} {ours / theirs:>6.2f} "
-            f"{geodesic:>13.3f} {sphere:>8.3f}"
-        )
+    for text in args.windows:
+        w = None if text.lower() == "none" else float(text)
+        for n_jobs in args.jobs:
+
+            def ours_call(j=n_jobs, w=w):
+                return dtw_pairwise_distance(X, Y, squared=True, window=w, n_jobs=j)
+
+            ours = best_time(ours_call, args.repeats)
+            theirs = best_time(
+                lambda j=n_jobs, w=w: aeon_pairwise(X, Y, window=w, n_jobs=j), args.repeats
+            )
+            geodesic = best_time(
+                lambda j=n_jobs, w=w: dtw_pairwise_distance(X, Y, window=w, n_jobs=j), 1
+            )
+            sphere = best_time(
+                lambda j=n_jobs, w=w: dtw_pairwise_distance(
+                    circle[0], circle[1], "sphere", window=w, n_jobs=j
+                ),
+                1,
+            )
+            print(
+                f"{text:>6} {n_jobs:>6} {ours:>11.3f} {theirs:>9.3f} {ours / theirs:>6.2f} "
+                f"{geodesic:>13.3f} {sphere:>8.3f}"
+            )
 
 
 if __name__ == "__main__":
