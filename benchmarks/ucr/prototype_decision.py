@@ -58,20 +58,23 @@ def refitted_on_folds(clf: RTWPrototypeClassifier, features, codes, seed: int) -
     return predicted
 
 
+def fit_and_predict(estimator, train, test):
+    """The fitted estimator, its test predictions, and the seconds of each."""
+    start = time.perf_counter()
+    estimator.fit(train.X, train.y)
+    middle = time.perf_counter()
+    predicted = estimator.predict(test.X)
+    return estimator, predicted, middle - start, time.perf_counter() - middle
+
+
 def measure(name: str, seed: int, data_dir: str) -> dict:
     train, test = load_split(name, "train", data_dir), load_split(name, "test", data_dir)
-    start = time.perf_counter()
-    nearest = RTWNearestCentroid(random_state=seed, n_jobs=1).fit(train.X, train.y)
-    nc_fit = time.perf_counter() - start
-    start = time.perf_counter()
-    nc_predicted = nearest.predict(test.X)
-    nc_predict = time.perf_counter() - start
-    start = time.perf_counter()
-    clf = RTWPrototypeClassifier(random_state=seed, n_jobs=1).fit(train.X, train.y)
-    fit = time.perf_counter() - start
-    start = time.perf_counter()
-    predicted = clf.predict(test.X)
-    predict = time.perf_counter() - start
+    _, nc_predicted, nc_fit, nc_predict = fit_and_predict(
+        RTWNearestCentroid(random_state=seed, n_jobs=1), train, test
+    )
+    clf, predicted, fit, predict = fit_and_predict(
+        RTWPrototypeClassifier(random_state=seed, n_jobs=1), train, test
+    )
 
     codes = np.searchsorted(clf.classes_, train.y)
     features = clf._features(clf.oof_distances_)
