@@ -132,9 +132,12 @@ def test_lane_blocks_cover_every_reference_once():
 
 def test_other_manifolds_and_few_pairs_keep_the_one_pair_kernel(monkeypatch, rng):
     many = _lanes.MIN_PAIRS
-    assert _lanes.lanes_apply(np.array([[0, 1, 0], [1, 4, 0]]), many)
-    assert not _lanes.lanes_apply(np.array([[0, 3, 0], [3, 7, 2]]), many)
-    assert not _lanes.lanes_apply(np.array([[0, 1, 0]]), many - 1)
+    assert _lanes.lanes_apply(np.array([[0, 1, 0], [1, 4, 0]]), many, 100)
+    assert not _lanes.lanes_apply(np.array([[0, 3, 0], [3, 7, 2]]), many, 100)
+    assert not _lanes.lanes_apply(np.array([[0, 1, 0]]), many - 1, 100)
+    # 60,000 samples of 3 coordinates fit a block; of 100 coordinates they do not
+    assert _lanes.lanes_apply(np.array([[0, 3, 0]]), many, 60_000)
+    assert not _lanes.lanes_apply(np.array([[0, 100, 0]]), many, 60_000)
     # the pairs counted are those computed: a symmetric matrix of 12 series has 66
     calls = []
     monkeypatch.setattr(_dtw, "_in_lanes", lambda *a: calls.append(a) or np.zeros((12, 12)))

@@ -274,7 +274,8 @@ def _pairwise(
         if not per_step:
             bounds = _guide_bounds(cx, cy, window, squared, symmetric)
             n_pairs = cx.n_series * (cx.n_series - 1) // 2 if symmetric else bounds.size
-            if _lanes.lanes_apply(segments, n_pairs) and np.isinf(bounds).all():
+            fits = _lanes.lanes_apply(segments, n_pairs, cy.max_length)
+            if fits and np.isinf(bounds).all():
                 return _in_lanes(flat_x, cx.lengths, flat_y, cy.lengths, segments, squared,
                                  window, symmetric)  # fmt: skip
             return _pruned.pairwise_segments(

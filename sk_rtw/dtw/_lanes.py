@@ -15,7 +15,9 @@ instructions; a sphere's or an SPD matrix's cost dominates its cell anyway).
 
 :func:`lane_blocks` groups the references: equal lengths together, blocks of
 :data:`WIDE` (then :data:`NARROW`) lanes; lengths shared by fewer than :data:`MIN_RUN`
-references stay with the one-pair kernel.
+references stay with the one-pair kernel, as do calls of fewer than :data:`MIN_PAIRS`
+pairs and references whose block would exceed :data:`BLOCK_BYTES` (the one-pair kernel
+holds two rows; a block holds its references and two rows in every lane).
 """
 
 from __future__ import annotations
@@ -44,9 +46,21 @@ MIN_RUN = 3
 MIN_PAIRS = 64
 
 
-def lanes_apply(segments: np.ndarray, n_pairs: int) -> bool:
-    """Whether the lanes compute these pairs: Euclidean segments only, enough pairs."""
-    return n_pairs >= MIN_PAIRS and bool(np.all(segments[:, 2] == SEGMENT_EUCLIDEAN))
+#: A block holds its references and two rows, ``(T (p + 2) WIDE)`` doubles per thread;
+#: longer or wider references than this allows keep the one-pair kernel (two rows).
+BLOCK_BYTES = 128 * 2**20
+
+
+def lanes_apply(segments: np.ndarray, n_pairs: int, max_length: int) -> bool:
+    """Whether the lanes compute these pairs: Euclidean segments only, enough pairs, and
+    blocks of at most :data:`BLOCK_BYTES` for references of ``max_length`` samples."""
+    point_size = int(segments[:, 1].max())
+    block = 8 * WIDE * (max_length + 1) * (point_size + 2)
+    return (
+        n_pairs >= MIN_PAIRS
+        and block <= BLOCK_BYTES
+        and bool(np.all(segments[:, 2] == SEGMENT_EUCLIDEAN))
+    )
 
 
 def lane_blocks(lengths: np.ndarray) -> tuple[list[np.ndarray], np.ndarray]:
