@@ -249,13 +249,12 @@ def _in_lanes(flat_x, lx, flat_y, ly, segments, squared, window, symmetric) -> n
         if len(blocks):
             kernel(flat_x, lx, flat_y, ly, segments, squared, window, blocks, symmetric, values)
     if len(single):
-        rest = _pruned.pairwise_segments(
-            flat_x, lx, flat_y[single], ly[single], segments, squared, window, False,
-            np.full((flat_x.shape[0], len(single)), np.inf),
-        )  # fmt: skip
+        rows, columns = np.meshgrid(np.arange(flat_x.shape[0]), single, indexing="ij")
         if symmetric:  # the upper triangle, as the one-pair kernel orients it
-            rest = np.where(single[None, :] > np.arange(flat_x.shape[0])[:, None], rest, 0.0)
-        values[:, single] = rest
+            upper = rows < columns
+            rows, columns = rows[upper], columns[upper]
+        _lanes.listed_pairs(flat_x, lx, flat_y, ly, segments, squared, window, rows.ravel(),
+                            columns.ravel(), values)  # fmt: skip
     if symmetric:
         values = np.triu(values, 1) + np.triu(values, 1).T
     return values

@@ -29,6 +29,7 @@ from numba import njit, prange
 
 from ._kernels import sakoe_chiba_rows
 from ._point_costs import _HUGE, _TINY, SEGMENT_EUCLIDEAN, _robust_distance
+from ._pruned import pruned_distance
 
 _INF = np.inf
 
@@ -213,3 +214,13 @@ def pairwise_narrow(X, lx, Y, ly, segments, squared, window, blocks, symmetric, 
         i = task // n_blocks
         _block(X, lx, Y, ly, segments, squared, window, i, blocks[task - i * n_blocks],
                symmetric, out, NARROW)  # fmt: skip
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def listed_pairs(X, lx, Y, ly, segments, squared, window, rows, columns, out):
+    """The pairs ``(rows[k], columns[k])`` one at a time (the one-pair kernel's plain
+    recursion), into ``out``: the references no block holds."""
+    for k in prange(rows.shape[0]):
+        i, j = rows[k], columns[k]
+        out[i, j] = pruned_distance(X[i, : lx[i]], Y[j, : ly[j]], segments, squared, window,
+                                    _INF)  # fmt: skip
