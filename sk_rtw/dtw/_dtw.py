@@ -217,6 +217,13 @@ def dtw_pairwise_distance(
     Returns
     -------
     distances : ndarray of shape (n_X, n_Y)
+
+    Notes
+    -----
+    On Euclidean points (and products of Euclidean spaces) the series of ``Y`` that share
+    a length with at least two others run 32 at a time against each series of ``X``, one
+    per vector lane: the same values as one pair at a time, bit for bit, several times
+    faster (``docs/benchmarks/dtw_speed.md``).
     """
     _check_normalize(normalize)
     w = check_window(window)
