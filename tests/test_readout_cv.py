@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+from unittest import mock
+
 import numpy as np
 import pytest
-from sklearn.linear_model import LogisticRegression, Ridge, RidgeClassifierCV
+from sklearn.base import clone
+from sklearn.linear_model import LogisticRegression, Ridge, RidgeClassifierCV, _ridge
 from sklearn.pipeline import make_pipeline
 from sklearn.preprocessing import LabelBinarizer, StandardScaler
 
@@ -12,6 +15,7 @@ from sk_rtw.estimators._out_of_fold import split_folds
 from sk_rtw.estimators._prototypes import default_readout
 from sk_rtw.estimators._readout_cv import (
     cross_validated_predictions,
+    fit_readout,
     is_default_readout,
     ridge_loo_predictions,
     ridge_loo_scores,
@@ -70,3 +74,36 @@ def test_other_readouts_are_refitted_on_the_folds(rng):
             LogisticRegression().fit(features[train], codes[train]).predict(features[test])
         )
     np.testing.assert_array_equal(got, expected)
+
+
+@pytest.mark.parametrize(("n", "p", "k"), [(120, 15, 3), (60, 6, 2)], ids=["three", "two"])
+def test_default_readout_fit_by_svd_equals_the_covariance_fit(n, p, k, rng):
+    features, codes = noisy_features(rng, n, p, k)
+    features = np.abs(features) + features[:, :1] ** 2  # correlated, uneven scales
+    plain = default_readout().fit(features, codes)
+    svd = _ridge._RidgeGCV._svd_decompose_design_matrix
+    with mock.patch.object(_ridge._RidgeGCV, "_svd_decompose_design_matrix", autospec=True,
+                           side_effect=svd) as spy:  # fmt: skip
+        fitted = fit_readout(default_readout(), features, codes)
+    assert spy.call_count == 1  # scikit-learn still honours the mode
+    assert fitted[-1].alpha_ == plain[-1].alpha_
+    np.testing.assert_allclose(fitted[-1].coef_, plain[-1].coef_, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(fitted[-1].intercept_, plain[-1].intercept_, atol=1e-12)
+    np.testing.assert_allclose(fitted[-1].best_score_, plain[-1].best_score_, rtol=1e-9)
+    np.testing.assert_array_equal(fitted.predict(features), plain.predict(features))
+    # the mode is no parameter: clone and repr show the readout the user gave
+    assert "gcv_mode" not in fitted[-1].get_params()
+    assert repr(fitted) == repr(plain)
+    assert not hasattr(clone(fitted)[-1], "gcv_mode") or clone(fitted)[-1].gcv_mode is None
+
+
+def test_other_readouts_and_wide_features_fit_as_given(rng):
+    features, codes = noisy_features(rng, 20, 40, 3)  # more features than series
+    with mock.patch.object(_ridge._RidgeGCV, "_svd_decompose_design_matrix") as spy:
+        fitted = fit_readout(default_readout(), features, codes)
+        weighted = make_pipeline(StandardScaler(), RidgeClassifierCV(class_weight="balanced"))
+        long_features, long_codes = noisy_features(rng, 80, 5, 3)
+        fit_readout(weighted, long_features, long_codes)
+    spy.assert_not_called()
+    assert getattr(fitted[-1], "gcv_mode", None) is None
+    assert getattr(weighted[-1], "gcv_mode", None) is None

@@ -27,7 +27,7 @@ from ._params import (
     set_params_with_hints,
     setting_hint,
 )
-from ._readout_cv import cross_validated_predictions
+from ._readout_cv import cross_validated_predictions, fit_readout
 from ._selection import Z_THRESHOLD, mcnemar
 
 if TYPE_CHECKING:
@@ -288,7 +288,7 @@ class RTWPrototypeClassifier(ClassifierMixin, TransformerMixin, BaseEstimator):
         self.distance_scale_ = float(np.median(positive)) if len(positive) else 1.0
         features = self._features(distances)
         unfitted = clone(readout)
-        readout.fit(features, codes)
+        fit_readout(readout, features, codes)
         self.decision_, self.cv_accuracy_ = self._decide(
             params["decision"], unfitted, readout, features, class_distances, codes,
             params["cv"], seed,

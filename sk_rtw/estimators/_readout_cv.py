@@ -1,14 +1,24 @@
-"""Cross-validated predictions of a prototype readout, for the choice of the decision.
+"""The default readout of a prototype classifier: its fit, and its cross-validated
+predictions for the choice of the decision.
 
 The default readout (standardised features, then ``RidgeClassifierCV``) is linear
-least squares with a ridge penalty, whose leave-one-out predictions follow from the
-fitted model in closed form (Allen's PRESS; Golub, Heath and Wahba 1979): with the hat
-matrix ``H = 11^T / n + Z (Z^T Z + alpha I)^{-1} Z^T`` of the centred features ``Z`` and
-the unpenalised intercept, the residual of series ``i`` left out is
+least squares with a ridge penalty. scikit-learn chooses its penalty by the leave-one-out
+errors of every candidate (generalised cross-validation); for more series than features
+``RidgeClassifierCV`` does so in its covariance mode, which forms the hat matrix's
+diagonal with an ``n p^2`` product per candidate penalty (13 of them by default), and it
+has no ``gcv_mode`` parameter to choose otherwise (``RidgeCV`` has). :func:`fit_readout`
+asks the same estimator for scikit-learn's SVD mode instead: one SVD of the features,
+then ``O(n p)`` per penalty; the same penalty and weights up to rounding, in half the
+time on a feature matrix of ElectricDevices' size (8,926 series, 2,234 centroids): 29
+against 14 s on one thread.
+
+Its leave-one-out predictions follow from the fitted model in closed form (Allen's
+PRESS; Golub, Heath and Wahba 1979): with the hat matrix
+``H = 11^T / n + Z (Z^T Z + alpha I)^{-1} Z^T`` of the centred features ``Z`` and the
+unpenalised intercept, the residual of series ``i`` left out is
 ``(y_i - yhat_i) / (1 - H_ii)``. One factorisation of a ``min(n, p)``-square matrix gives
 every series' left-out prediction, where refitting the readout on folds costs a
-``RidgeClassifierCV`` fit (an SVD of the whole feature matrix) per fold: on
-ElectricDevices (8,926 series, 2,234 centroids) five such fits took longer than the
+``RidgeClassifierCV`` fit per fold: on ElectricDevices five such fits took longer than the
 out-of-fold centroids. Any other readout is refitted on the folds of the out-of-fold
 distances.
 """
@@ -41,6 +51,17 @@ def is_default_readout(readout: Any) -> bool:
         and ridge.class_weight is None
         and ridge.cv is None
     )
+
+
+def fit_readout(readout: Any, features: np.ndarray, codes: np.ndarray) -> Any:
+    """Fit ``readout`` on ``features`` and ``codes``; the default readout with more series
+    than features by scikit-learn's SVD mode of generalised cross-validation (module
+    docstring): the same fit up to rounding. Returns ``readout``, fitted."""
+    if is_default_readout(readout) and features.shape[0] > features.shape[1]:
+        # RidgeClassifierCV.fit reads the attribute as RidgeCV does its parameter; it is
+        # not a parameter of the classifier, so clone, get_params and repr never see it
+        readout.steps[1][1].gcv_mode = "svd"
+    return readout.fit(features, codes)
 
 
 def ridge_loo_predictions(readout: Pipeline, features: np.ndarray, codes: np.ndarray):
