@@ -94,14 +94,17 @@ def run_fold(space, demos, shapes, fold, rows, method, seed, verbose) -> dict:
 
 
 def warm_up(rows) -> None:
-    """Untimed first calls: numba compiles MiniRocket's kernels, torch and the DTW kernels
-    load (a few seconds that would land in the first fold's times)."""
+    """Untimed first calls: numba compiles MiniRocket's kernels (univariate and
+    multivariate ones: the coordinates have 3 or 4 channels), torch and the DTW kernels
+    load (seconds that would land in the first fold's times: 18 s for MiniRocket's
+    multivariate kernels)."""
     rng = np.random.default_rng(0)
     X, y = rng.standard_normal((8, 20)).cumsum(1), np.repeat([0, 1], 4)
     if "minirocket" in rows:
         from aeon.classification.convolution_based import MiniRocketClassifier
 
-        MiniRocketClassifier(random_state=0).fit(X[:, None], y)
+        for channels in (X[:, None], np.stack([X, X[::-1], -X], axis=1)):
+            MiniRocketClassifier(random_state=0).fit(channels, y).predict(channels)
     if "prototype" in rows or "nearest-centroid" in rows:
         RTWNearestCentroid(method=method_object("rtw", n_epochs=2)).fit(X, y).predict(X)
 
