@@ -22,8 +22,6 @@ prototype classifier against the nearest centroid's.
 
 from __future__ import annotations
 
-import argparse
-import json
 import sys
 import time
 from collections import defaultdict
@@ -38,6 +36,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the repository; 
 
 from benchmarks._shared import machine
 from benchmarks.ucr._data import load_split
+from benchmarks.ucr._halves_cli import append_record, halves_parser, read_records
 from benchmarks.ucr._summary import FIXED_HALVES
 from sk_rtw import RTWNearestCentroid, RTWPrototypeClassifier
 from sk_rtw.estimators._out_of_fold import split_folds
@@ -150,18 +149,10 @@ def summary(records: list[dict]) -> None:
 
 
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--data-dir", required=True)
-    parser.add_argument("--halves", nargs="+", default=["A", "B"], choices=list(FIXED_HALVES))
-    parser.add_argument("--seeds", nargs="+", type=int, default=[0])
-    parser.add_argument("--out", type=Path, required=True)
-    args = parser.parse_args(argv)
+    args = halves_parser(__doc__.splitlines()[0]).parse_args(argv)
     print(f"machine: {machine()}; one thread", flush=True)
-    records = []
-    if args.out.exists():
-        records = [json.loads(line) for line in args.out.read_text().splitlines()]
+    records = read_records(args.out)
     done = {(r["dataset"], r["seed"]) for r in records}
-    args.out.parent.mkdir(parents=True, exist_ok=True)
     with threadpool_limits(1):
         warm_up()
         for seed in args.seeds:
@@ -171,8 +162,7 @@ def main(argv=None) -> None:
                         continue
                     record = measure(name, seed, args.data_dir)
                     records.append(record)
-                    with args.out.open("a") as handle:
-                        handle.write(json.dumps(record) + "\n")
+                    append_record(args.out, record)
                     print(
                         f"{name} seed {seed}: {record['decision']} "
                         f"({record['prototype']:.4f}), fit {record['fit']:.1f} s",

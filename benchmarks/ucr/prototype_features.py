@@ -3,16 +3,16 @@
 Usage::
 
     python benchmarks/ucr/prototype_features.py --data-dir ../shared/ucr --halves A B \\
-        --seed 0 --out results/features_dev.jsonl
+        --seeds 0 --out results/features_dev.jsonl
     python benchmarks/ucr/prototype_features.py --data-dir ../shared/ucr_large \\
-        --halves C1 C2 --seed 0 --out results/features_large.jsonl
+        --halves C1 C2 --seeds 0 --out results/features_large.jsonl
 
 ``RTWPrototypeClassifier`` reads out one feature per centroid: column ``m`` is "the
 distance to centroid ``m``", so ``readout_weights_`` can name the centroids that weigh for
 and against a class. A readout can also be given features that do not depend on which
 centroid of a class is which: every class's distances sorted (``ranked``), its three
-nearest (``ranked3``), or its nearest only (``class_min``). Per dataset, on one thread,
-``RTWPrototypeClassifier(random_state=seed)`` is fitted once; from its out-of-fold
+nearest (``ranked3``), or its nearest only (``class_min``). Per dataset and seed, on one
+thread, ``RTWPrototypeClassifier(random_state=seed)`` is fitted once; from its out-of-fold
 training distances and its test distances each feature set gets the default readout
 (``log1p`` of the distances over the fit's scale, standardised, ``RidgeClassifierCV``)
 and the classifier's decision rule (the readout where its exact leave-one-out
@@ -23,8 +23,6 @@ appended to ``--out`` as it finishes (JSON lines; a rerun skips what is there).
 
 from __future__ import annotations
 
-import argparse
-import json
 import sys
 from pathlib import Path
 
@@ -35,6 +33,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the repository
 
 from benchmarks._shared import machine
 from benchmarks.ucr._data import load_split
+from benchmarks.ucr._halves_cli import append_record, halves_parser, read_records
 from benchmarks.ucr._summary import FIXED_HALVES
 from sk_rtw import RTWPrototypeClassifier
 from sk_rtw.estimators._prototypes import default_readout
@@ -81,37 +80,30 @@ def measure(name: str, seed: int, data_dir: str) -> dict:
 
 
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--data-dir", required=True)
-    parser.add_argument("--halves", nargs="+", default=["A", "B"], choices=list(FIXED_HALVES))
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--out", type=Path, required=True)
-    args = parser.parse_args(argv)
+    args = halves_parser(__doc__.splitlines()[0]).parse_args(argv)
     print(f"machine: {machine()}; one thread", flush=True)
-    records = []
-    if args.out.exists():
-        records = [json.loads(line) for line in args.out.read_text().splitlines()]
+    records = read_records(args.out)
     done = {(r["dataset"], r["seed"]) for r in records}
-    args.out.parent.mkdir(parents=True, exist_ok=True)
     with threadpool_limits(1):
-        for half in args.halves:
-            for name in FIXED_HALVES[half]:
-                if (name, args.seed) in done:
-                    continue
-                record = measure(name, args.seed, args.data_dir)
-                records.append(record)
-                with args.out.open("a") as handle:
-                    handle.write(json.dumps(record) + "\n")
-                print(f"{name}: " + ", ".join(
-                    f"{f} {record[f + '_rule']:.3f}" for f in FEATURES), flush=True)  # fmt: skip
+        for seed in args.seeds:
+            for half in args.halves:
+                for name in FIXED_HALVES[half]:
+                    if (name, seed) in done:
+                        continue
+                    record = measure(name, seed, args.data_dir)
+                    records.append(record)
+                    append_record(args.out, record)
+                    rules = ", ".join(f"{f} {record[f + '_rule']:.3f}" for f in FEATURES)
+                    print(f"{name} seed {seed}: {rules}", flush=True)
     columns = ["nearest"] + [f"{f}_{kind}" for f in FEATURES for kind in ("readout", "rule")]
-    print(f"\n| half | sets | {' | '.join(columns)} |\n|{' --- |' * (len(columns) + 2)}")
-    for half in args.halves:
-        members = FIXED_HALVES[half]
-        rows = [r for r in records if r["dataset"] in members and r["seed"] == args.seed]
-        if rows:
-            means = " | ".join(f"{np.mean([r[c] for r in rows]):.4f}" for c in columns)
-            print(f"| {half} | {len(rows)} | {means} |")
+    print(f"\n| half | seed | sets | {' | '.join(columns)} |\n|{' --- |' * (len(columns) + 3)}")
+    for seed in args.seeds:
+        for half in args.halves:
+            members = FIXED_HALVES[half]
+            rows = [r for r in records if r["dataset"] in members and r["seed"] == seed]
+            if rows:
+                means = " | ".join(f"{np.mean([r[c] for r in rows]):.4f}" for c in columns)
+                print(f"| {half} | {seed} | {len(rows)} | {means} |")
 
 
 if __name__ == "__main__":

@@ -2,7 +2,7 @@
 
 Usage::
 
-    python benchmarks/ucr/series_features.py --data-dir ../shared/ucr --halves A B --seed 0
+    python benchmarks/ucr/series_features.py --data-dir ../shared/ucr --halves A B --seeds 0
 
 The prototype classifier reads out distances to centroids. This script measures the
 richest readout of that kind a small training set allows: the DTW distances of a series
@@ -13,14 +13,12 @@ thread: ``RTWNearestCentroid(random_state=seed)`` fitted (its accuracy and its c
 band, which every other row uses), 1-NN DTW at that band, and the readout twice: with
 the training rows as they are (a series' distance to itself is 0, a value no test series
 shows) and with that entry replaced by the series' distance to its nearest other
-training series. Mean accuracy per half is printed; ``--out`` keeps every dataset's row
-(JSON lines).
+training series. Mean accuracy per half and seed is printed; ``--out`` keeps every
+dataset's row (JSON lines, appended as each finishes; a rerun skips what is there).
 """
 
 from __future__ import annotations
 
-import argparse
-import json
 import sys
 from pathlib import Path
 
@@ -31,6 +29,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the repository
 
 from benchmarks._shared import machine
 from benchmarks.ucr._data import load_split
+from benchmarks.ucr._halves_cli import append_record, halves_parser, read_records
 from benchmarks.ucr._summary import FIXED_HALVES
 from sk_rtw import RTWNearestCentroid, dtw_pairwise_distance
 from sk_rtw.estimators._prototypes import default_readout
@@ -64,22 +63,23 @@ def measure(name: str, seed: int, data_dir: str) -> dict:
 
 
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--data-dir", required=True)
-    parser.add_argument("--halves", nargs="+", default=["A", "B"], choices=list(FIXED_HALVES))
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--out", type=Path, default=None)
-    args = parser.parse_args(argv)
+    args = halves_parser(__doc__.splitlines()[0], out_required=False).parse_args(argv)
     print(f"machine: {machine()}; one thread", flush=True)
-    print(f"\n| half | datasets | {' | '.join(ROWS)} |\n|{' --- |' * (len(ROWS) + 2)}")
+    records = read_records(args.out)
+    done = {(r["dataset"], r["seed"]) for r in records}
     with threadpool_limits(1):
+        for seed in args.seeds:
+            for half in args.halves:
+                for name in FIXED_HALVES[half]:
+                    if (name, seed) not in done:
+                        records.append(measure(name, seed, args.data_dir))
+                        append_record(args.out, records[-1])
+    print(f"\n| half | seed | datasets | {' | '.join(ROWS)} |\n|{' --- |' * (len(ROWS) + 3)}")
+    for seed in args.seeds:
         for half in args.halves:
-            records = [measure(name, args.seed, args.data_dir) for name in FIXED_HALVES[half]]
-            if args.out is not None:
-                with args.out.open("a") as handle:
-                    handle.writelines(json.dumps(r) + "\n" for r in records)
-            means = " | ".join(f"{np.mean([r[row] for r in records]):.4f}" for row in ROWS)
-            print(f"| {half} | {len(records)} | {means} |", flush=True)
+            rows = [r for r in records if r["dataset"] in FIXED_HALVES[half] and r["seed"] == seed]
+            means = " | ".join(f"{np.mean([r[row] for r in rows]):.4f}" for row in ROWS)
+            print(f"| {half} | {seed} | {len(rows)} | {means} |", flush=True)
 
 
 if __name__ == "__main__":

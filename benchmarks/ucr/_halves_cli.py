@@ -1,0 +1,38 @@
+"""The command line and the record file shared by the per-half UCR studies
+(``prototype_decision.py``, ``prototype_features.py``, ``series_features.py``): a data
+directory, fixed halves, seeds, and JSON lines appended one dataset at a time, so that a
+rerun skips what is there."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+from benchmarks.ucr._summary import FIXED_HALVES
+
+
+def halves_parser(description: str, *, out_required: bool = True) -> argparse.ArgumentParser:
+    """``--data-dir``, ``--halves`` (default A and B), ``--seeds`` (default 0), ``--out``."""
+    parser = argparse.ArgumentParser(description=description)
+    parser.add_argument("--data-dir", required=True)
+    parser.add_argument("--halves", nargs="+", default=["A", "B"], choices=list(FIXED_HALVES))
+    parser.add_argument("--seeds", nargs="+", type=int, default=[0])
+    parser.add_argument("--out", type=Path, required=out_required)
+    return parser
+
+
+def read_records(path: Path | None) -> list[dict]:
+    """The records already in ``path`` (none if it is None or absent)."""
+    if path is None or not path.exists():
+        return []
+    return [json.loads(line) for line in path.read_text().splitlines()]
+
+
+def append_record(path: Path | None, record: dict) -> None:
+    """Append ``record`` to ``path`` as one JSON line (nothing if it is None)."""
+    if path is None:
+        return
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with path.open("a") as handle:
+        handle.write(json.dumps(record) + "\n")
