@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import json
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 from benchmarks.ucr._summary import FIXED_HALVES
@@ -36,3 +37,21 @@ def append_record(path: Path | None, record: dict) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     with path.open("a") as handle:
         handle.write(json.dumps(record) + "\n")
+
+
+def measure_missing(
+    args: argparse.Namespace, records: list[dict], measure: Callable[[str, int, str], dict]
+) -> Iterator[dict]:
+    """``measure(name, seed, data_dir)`` for every dataset of ``args.halves`` and seed of
+    ``args.seeds`` that ``records`` lacks; each new record is added to ``records``,
+    appended to ``args.out`` and yielded."""
+    done = {(r["dataset"], r["seed"]) for r in records}
+    for seed in args.seeds:
+        for half in args.halves:
+            for name in FIXED_HALVES[half]:
+                if (name, seed) in done:
+                    continue
+                record = measure(name, seed, args.data_dir)
+                records.append(record)
+                append_record(args.out, record)
+                yield record

@@ -36,7 +36,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the repository; 
 
 from benchmarks._shared import machine
 from benchmarks.ucr._data import load_split
-from benchmarks.ucr._halves_cli import append_record, halves_parser, read_records
+from benchmarks.ucr._halves_cli import halves_parser, measure_missing, read_records
 from benchmarks.ucr._summary import FIXED_HALVES
 from sk_rtw import RTWNearestCentroid, RTWPrototypeClassifier
 from sk_rtw.estimators._out_of_fold import split_folds
@@ -152,22 +152,14 @@ def main(argv=None) -> None:
     args = halves_parser(__doc__.splitlines()[0]).parse_args(argv)
     print(f"machine: {machine()}; one thread", flush=True)
     records = read_records(args.out)
-    done = {(r["dataset"], r["seed"]) for r in records}
     with threadpool_limits(1):
         warm_up()
-        for seed in args.seeds:
-            for half in args.halves:
-                for name in FIXED_HALVES[half]:
-                    if (name, seed) in done:
-                        continue
-                    record = measure(name, seed, args.data_dir)
-                    records.append(record)
-                    append_record(args.out, record)
-                    print(
-                        f"{name} seed {seed}: {record['decision']} "
-                        f"({record['prototype']:.4f}), fit {record['fit']:.1f} s",
-                        flush=True,
-                    )
+        for record in measure_missing(args, records, measure):
+            print(
+                f"{record['dataset']} seed {record['seed']}: {record['decision']} "
+                f"({record['prototype']:.4f}), fit {record['fit']:.1f} s",
+                flush=True,
+            )
     summary([r for r in records if r["seed"] in args.seeds])
 
 

@@ -33,7 +33,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the repository
 
 from benchmarks._shared import machine
 from benchmarks.ucr._data import load_split
-from benchmarks.ucr._halves_cli import append_record, halves_parser, read_records
+from benchmarks.ucr._halves_cli import halves_parser, measure_missing, read_records
 from benchmarks.ucr._summary import FIXED_HALVES
 from sk_rtw import RTWPrototypeClassifier
 from sk_rtw.estimators._prototypes import default_readout
@@ -83,18 +83,10 @@ def main(argv=None) -> None:
     args = halves_parser(__doc__.splitlines()[0]).parse_args(argv)
     print(f"machine: {machine()}; one thread", flush=True)
     records = read_records(args.out)
-    done = {(r["dataset"], r["seed"]) for r in records}
     with threadpool_limits(1):
-        for seed in args.seeds:
-            for half in args.halves:
-                for name in FIXED_HALVES[half]:
-                    if (name, seed) in done:
-                        continue
-                    record = measure(name, seed, args.data_dir)
-                    records.append(record)
-                    append_record(args.out, record)
-                    rules = ", ".join(f"{f} {record[f + '_rule']:.3f}" for f in FEATURES)
-                    print(f"{name} seed {seed}: {rules}", flush=True)
+        for record in measure_missing(args, records, measure):
+            rules = ", ".join(f"{f} {record[f + '_rule']:.3f}" for f in FEATURES)
+            print(f"{record['dataset']} seed {record['seed']}: {rules}", flush=True)
     columns = ["nearest"] + [f"{f}_{kind}" for f in FEATURES for kind in ("readout", "rule")]
     print(f"\n| half | seed | sets | {' | '.join(columns)} |\n|{' --- |' * (len(columns) + 3)}")
     for seed in args.seeds:

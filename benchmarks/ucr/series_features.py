@@ -29,7 +29,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the repository
 
 from benchmarks._shared import machine
 from benchmarks.ucr._data import load_split
-from benchmarks.ucr._halves_cli import append_record, halves_parser, read_records
+from benchmarks.ucr._halves_cli import halves_parser, measure_missing, read_records
 from benchmarks.ucr._summary import FIXED_HALVES
 from sk_rtw import RTWNearestCentroid, dtw_pairwise_distance
 from sk_rtw.estimators._prototypes import default_readout
@@ -66,14 +66,10 @@ def main(argv=None) -> None:
     args = halves_parser(__doc__.splitlines()[0], out_required=False).parse_args(argv)
     print(f"machine: {machine()}; one thread", flush=True)
     records = read_records(args.out)
-    done = {(r["dataset"], r["seed"]) for r in records}
     with threadpool_limits(1):
-        for seed in args.seeds:
-            for half in args.halves:
-                for name in FIXED_HALVES[half]:
-                    if (name, seed) not in done:
-                        records.append(measure(name, seed, args.data_dir))
-                        append_record(args.out, records[-1])
+        for record in measure_missing(args, records, measure):
+            shown = ", ".join(f"{row} {record[row]:.3f}" for row in ROWS)
+            print(f"{record['dataset']} seed {record['seed']}: {shown}", flush=True)
     print(f"\n| half | seed | datasets | {' | '.join(ROWS)} |\n|{' --- |' * (len(ROWS) + 3)}")
     for seed in args.seeds:
         for half in args.halves:
