@@ -22,13 +22,13 @@ prototype classifier against the nearest centroid's.
 
 from __future__ import annotations
 
+import functools
 import sys
 import time
 from collections import defaultdict
 from pathlib import Path
 
 import numpy as np
-from sklearn.base import clone
 from sklearn.utils import check_random_state
 from threadpoolctl import threadpool_limits
 
@@ -41,6 +41,7 @@ from benchmarks.ucr._summary import FIXED_HALVES
 from sk_rtw import RTWNearestCentroid, RTWPrototypeClassifier
 from sk_rtw.estimators._out_of_fold import split_folds
 from sk_rtw.estimators._prototypes import default_readout
+from sk_rtw.estimators._readout_cv import fit_readout
 from sk_rtw.estimators._selection import Z_THRESHOLD, mcnemar
 
 
@@ -52,7 +53,7 @@ def refitted_on_folds(clf: RTWPrototypeClassifier, features, codes, seed: int) -
         if len(np.unique(codes[train])) < 2:
             predicted[test] = codes[train][0]
             continue
-        readout = clone(default_readout()).fit(features[train], codes[train])
+        readout = fit_readout(default_readout(), features[train], codes[train])
         predicted[test] = readout.predict(features[test])
     return predicted
 
@@ -79,13 +80,13 @@ def warm_up() -> None:
     RTWPrototypeClassifier(random_state=0, n_jobs=1).fit(X, y).predict(X)
 
 
-def measure(name: str, seed: int, data_dir: str) -> dict:
+def measure(name: str, seed: int, data_dir: str, cv: int = 5) -> dict:
     train, test = load_split(name, "train", data_dir), load_split(name, "test", data_dir)
     _, nc_predicted, nc_fit, nc_predict = fit_and_predict(
         RTWNearestCentroid(random_state=seed, n_jobs=1), train, test
     )
     clf, predicted, fit, predict = fit_and_predict(
-        RTWPrototypeClassifier(random_state=seed, n_jobs=1), train, test
+        RTWPrototypeClassifier(random_state=seed, n_jobs=1, cv=cv), train, test
     )
 
     codes = np.searchsorted(clf.classes_, train.y)
@@ -106,7 +107,8 @@ def measure(name: str, seed: int, data_dir: str) -> dict:
 
     half = next((h for h, members in FIXED_HALVES.items() if name in members), "-")
     return {
-        "dataset": name, "seed": seed, "half": half, "n_means": len(clf.centroid_classes_),
+        "dataset": name, "seed": seed, "half": half, "cv": cv,
+        "n_means": len(clf.centroid_classes_),
         "nearest_centroid": accuracy(nc_predicted), "prototype": accuracy(predicted),
         "decision": clf.decision_, "z": clf.cv_accuracy_["z"],
         "folds_decision": folds_decision, "folds_z": z_folds,
@@ -149,12 +151,15 @@ def summary(records: list[dict]) -> None:
 
 
 def main(argv=None) -> None:
-    args = halves_parser(__doc__.splitlines()[0]).parse_args(argv)
+    parser = halves_parser(__doc__.splitlines()[0])
+    parser.add_argument("--cv", type=int, default=5, help="the classifier's folds (cv)")
+    args = parser.parse_args(argv)
     print(f"machine: {machine()}; one thread", flush=True)
     records = read_records(args.out)
     with threadpool_limits(1):
         warm_up()
-        for record in measure_missing(args, records, measure):
+        measured = functools.partial(measure, cv=args.cv)
+        for record in measure_missing(args, records, measured):
             print(
                 f"{record['dataset']} seed {record['seed']}: {record['decision']} "
                 f"({record['prototype']:.4f}), fit {record['fit']:.1f} s",
