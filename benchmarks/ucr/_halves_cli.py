@@ -10,6 +10,8 @@ import json
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
+import numpy as np
+
 from benchmarks.ucr._summary import FIXED_HALVES
 
 
@@ -55,3 +57,15 @@ def measure_missing(
                 records.append(record)
                 append_record(args.out, record)
                 yield record
+
+
+def print_half_means(records: list[dict], args: argparse.Namespace, columns: list[str]) -> None:
+    """A markdown table of the mean of every column, per half and seed of ``args``."""
+    print(f"\n| half | seed | sets | {' | '.join(columns)} |\n|{' --- |' * (len(columns) + 3)}")
+    for seed in args.seeds:
+        for half in args.halves:
+            members = FIXED_HALVES[half]
+            rows = [r for r in records if r["dataset"] in members and r["seed"] == seed]
+            if rows:
+                means = " | ".join(f"{np.mean([r[c] for r in rows]):.4f}" for c in columns)
+                print(f"| {half} | {seed} | {len(rows)} | {means} |", flush=True)

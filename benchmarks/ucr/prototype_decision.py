@@ -155,7 +155,8 @@ def main(argv=None) -> None:
     parser.add_argument("--cv", type=int, default=5, help="the classifier's folds (cv)")
     args = parser.parse_args(argv)
     print(f"machine: {machine()}; one thread", flush=True)
-    records = read_records(args.out)
+    # records of other folds in the same file are left out (and not counted as done)
+    records = [r for r in read_records(args.out) if r.get("cv", 5) == args.cv]
     with threadpool_limits(1):
         warm_up()
         measured = functools.partial(measure, cv=args.cv)

@@ -33,8 +33,12 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the repository
 
 from benchmarks._shared import machine
 from benchmarks.ucr._data import load_split
-from benchmarks.ucr._halves_cli import halves_parser, measure_missing, read_records
-from benchmarks.ucr._summary import FIXED_HALVES
+from benchmarks.ucr._halves_cli import (
+    halves_parser,
+    measure_missing,
+    print_half_means,
+    read_records,
+)
 from sk_rtw import RTWPrototypeClassifier
 from sk_rtw.estimators._prototypes import default_readout
 from sk_rtw.estimators._readout_cv import fit_readout, ridge_loo_predictions
@@ -88,14 +92,7 @@ def main(argv=None) -> None:
             rules = ", ".join(f"{f} {record[f + '_rule']:.3f}" for f in FEATURES)
             print(f"{record['dataset']} seed {record['seed']}: {rules}", flush=True)
     columns = ["nearest"] + [f"{f}_{kind}" for f in FEATURES for kind in ("readout", "rule")]
-    print(f"\n| half | seed | sets | {' | '.join(columns)} |\n|{' --- |' * (len(columns) + 3)}")
-    for seed in args.seeds:
-        for half in args.halves:
-            members = FIXED_HALVES[half]
-            rows = [r for r in records if r["dataset"] in members and r["seed"] == seed]
-            if rows:
-                means = " | ".join(f"{np.mean([r[c] for r in rows]):.4f}" for c in columns)
-                print(f"| {half} | {seed} | {len(rows)} | {means} |")
+    print_half_means(records, args, columns)
 
 
 if __name__ == "__main__":

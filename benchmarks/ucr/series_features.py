@@ -29,8 +29,12 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the repository
 
 from benchmarks._shared import machine
 from benchmarks.ucr._data import load_split
-from benchmarks.ucr._halves_cli import halves_parser, measure_missing, read_records
-from benchmarks.ucr._summary import FIXED_HALVES
+from benchmarks.ucr._halves_cli import (
+    halves_parser,
+    measure_missing,
+    print_half_means,
+    read_records,
+)
 from sk_rtw import RTWNearestCentroid, dtw_pairwise_distance
 from sk_rtw.estimators._prototypes import default_readout
 
@@ -70,12 +74,7 @@ def main(argv=None) -> None:
         for record in measure_missing(args, records, measure):
             shown = ", ".join(f"{row} {record[row]:.3f}" for row in ROWS)
             print(f"{record['dataset']} seed {record['seed']}: {shown}", flush=True)
-    print(f"\n| half | seed | datasets | {' | '.join(ROWS)} |\n|{' --- |' * (len(ROWS) + 3)}")
-    for seed in args.seeds:
-        for half in args.halves:
-            rows = [r for r in records if r["dataset"] in FIXED_HALVES[half] and r["seed"] == seed]
-            means = " | ".join(f"{np.mean([r[row] for r in rows]):.4f}" for row in ROWS)
-            print(f"| {half} | {seed} | {len(rows)} | {means} |", flush=True)
+    print_half_means(records, args, list(ROWS))
 
 
 if __name__ == "__main__":
