@@ -221,22 +221,34 @@ def test_the_torch_floor_is_read_from_the_version():
     assert f'"torch>={MIN_TORCH[0]}.{MIN_TORCH[1]}"' in pyproject
 
 
-def _start_rule_reference(history, patience, near=2.5):
+def _start_rule_reference(history, patience, near=2.5, early=3, far=20.0):
     """Epochs a group runs under ``start_patience`` alone, written from its statement:
     after ``patience`` epochs, stop if the lowest loss since the first epoch is still
-    more than ``near`` times the first epoch's."""
-    for epoch in range(patience - 1, len(history)):
-        if min(history[1 : epoch + 1]) > near * history[0]:
-            return epoch + 1
+    more than ``near`` times the first epoch's; after ``early`` epochs, if it is more
+    than ``far`` times it."""
+    for epoch in range(1, len(history)):
+        low, done = min(history[1 : epoch + 1]), epoch + 1
+        if (done >= patience and low > near * history[0]) or (
+            done >= early and low > far * history[0]
+        ):
+            return done
     return len(history)
+
+
+def test_the_start_rule_constants_are_the_documented_ones():
+    from sk_rtw.align._training import EARLY_PATIENCE, FAR_FROM_START, NEAR_START
+
+    assert (NEAR_START, EARLY_PATIENCE, FAR_FROM_START) == (2.5, 3, 20.0)
 
 
 # scripted losses (relative to the start's): the long demonstrations' far and slowly
 # falling climb-down; a short series' return that beats the start at epoch 8; one that
 # stays near the start (the no-change stop's case, not this rule's); one beaten at once;
-# one thrown far that comes back within 2.5 times the start's loss at epoch 4
+# one thrown far that comes back within 2.5 times the start's loss at epoch 4; one thrown
+# very far that is within 20 times the start's after two epochs and beats it at epoch 7
 _SCRIPTS = {
     "far, falling": [1.0, 136.5, 26.0, 19.6, 22.3, 12.8, 4.1, 4.3, 2.2, 3.5, 3.1, 2.9, 2.2],
+    "very far, back": [1.0, 90.0, 19.0, 6.0, 2.0, 1.3, 1.1, 0.99, 0.98, 0.97, 0.96, 0.96],
     "near, falling back": [1.0, 1.54, 1.06, 1.02, 1.1, 1.06, 1.01, 1.005, 0.97, 0.95, 0.96],
     "near, stalled": [1.0, 1.3, 1.2, 1.25, 1.3, 1.21, 1.22, 1.24, 1.2, 1.23, 1.25, 1.22],
     "beaten": [1.0, 0.9, 1.4, 1.5, 1.6, 1.4, 1.5, 1.45, 1.6, 1.5, 1.55, 1.5, 1.6],
@@ -276,11 +288,15 @@ def test_start_patience_stops_each_group_as_the_rule_says(patience):
     for g, script in enumerate(scripts):
         np.testing.assert_array_equal(trainer.progress.history[: runs[g], g], script[: runs[g]])
         assert best[g] == int(np.argmin(script[: runs[g]]))
-    far, back, stalled, beaten, back_at_4 = runs
-    assert far == patience and back == stalled == beaten == n_epochs
+    far, very_far_back, back, stalled, beaten, back_at_4 = runs
+    # 26 times the start's after two epochs: the early tier stops it at the third
+    assert far == min(patience, 3) and back == stalled == beaten == n_epochs
     assert back_at_4 == (patience if patience <= 4 else n_epochs)
+    # 19 times after two epochs is not far enough for the early tier
+    assert very_far_back == (patience if patience <= 4 else n_epochs)
     if patience >= 6:  # what the rule is for: only the far group stops, keeping the start
-        assert best[0] == 0 and list(runs[1:]) == [n_epochs] * 4
+        assert best[0] == 0 and list(runs[1:]) == [n_epochs] * 5
+        assert best[1] == int(np.argmin(scripts[1][:n_epochs]))  # beat the start
 
 
 def test_the_start_rule_returns_the_start_where_training_cannot_beat_it():
@@ -296,3 +312,25 @@ def test_the_start_rule_returns_the_start_where_training_cannot_beat_it():
     assert kept.n_iter == kept.config.start_patience == 8 and full.n_iter == 21
     np.testing.assert_array_equal(kept.warps, full.warps)
     np.testing.assert_allclose(kept.mean, full.mean, rtol=0, atol=1e-13)
+
+
+def test_the_early_tier_returns_the_start_after_three_epochs_on_long_series(capsys):
+    """2,000 quaternion samples: two epochs after the start the loss is still more than
+    20 times the start's (long demonstrations: 23-2,200 times); the early tier returns
+    the same start after 3 epochs, and says which rule stopped the fit."""
+    from sk_rtw.align._training import EARLY_PATIENCE, FAR_FROM_START
+
+    X = np.asarray(make_warped_signals("quaternion", 4, 2000, random_state=0).signals)
+    kept = align(X, manifold="quaternion", random_state=0, verbose=True)
+    err = capsys.readouterr().err
+    full = align(X, manifold="quaternion", random_state=0, start_patience=None)
+    history = np.asarray(full.loss_history[: full.n_iter])
+    assert history[1:EARLY_PATIENCE].min() > FAR_FROM_START * history[0]
+    assert full.best_epoch == kept.best_epoch == 0
+    assert kept.n_iter == EARLY_PATIENCE < kept.config.start_patience
+    np.testing.assert_array_equal(kept.warps, full.warps)
+    np.testing.assert_allclose(kept.mean, full.mean, rtol=0, atol=1e-13)
+    assert (
+        "stopped early after 3 of 256 epochs: after 3 epochs the loss was still more "
+        "than 20 times the start's" in err
+    )

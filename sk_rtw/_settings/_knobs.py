@@ -206,7 +206,8 @@ KNOBS: dict[str, Knob] = {
             "start_patience",
             (*_integer(2), Constant(None, "no such stop")),
             "Stop after this many epochs if the lowest loss since the first epoch is still "
-            "more than 2.5 times the first epoch's (the DTW start's), keeping the start.",
+            "more than 2.5 times the first epoch's (the DTW start's), keeping the start; "
+            "after 3 epochs if it is still more than 20 times it.",
             _every(None),
         ),
         Knob(

@@ -88,7 +88,7 @@ class BatchOptimisation:
         config = self.config
         note = early_stop_note(config.method, done, config.n_epochs, self.best_epoch,
                                config.n_iter_no_change, config.tol,
-                               config.start_patience)  # fmt: skip
+                               config.start_patience, self.losses[:done])  # fmt: skip
         if self.verbose and note:
             print(note, file=sys.stderr, flush=True)
         history[:done] = self.losses[:done]

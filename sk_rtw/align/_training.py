@@ -26,6 +26,10 @@ group follows exactly the trajectory of a separate fit. Per group the loop keeps
   replays recorded histories under other patiences and ratios: shorter patiences or a
   ratio of 2 cut training on the generated sets that it would have won.
   A group hovering near its start is left to ``n_iter_no_change``.
+  A group still *far* from its start stops sooner: one whose lowest loss after
+  :data:`EARLY_PATIENCE` epochs is more than :data:`FAR_FROM_START` times the start's
+  (the same replays: no group that went on to beat its start was above 7.2 times it
+  after two epochs; long demonstrations were 23-2,200 times above it).
 
 A caller may pause the loop (``run(pause=...)``) and continue with the running groups
 only (:meth:`Trainer.narrow`): best iterates, counters, history and Adam's moments are
@@ -63,6 +67,10 @@ WARMUP_EPOCHS = 3
 #: ``start_patience`` stops a group whose lowest loss after the first epoch is still more
 #: than this multiple of the start's (measured: docs/benchmarks/align_speed.md).
 NEAR_START = 2.5
+#: ... and, after :data:`EARLY_PATIENCE` epochs, one whose lowest loss is still more than
+#: this multiple of the start's (whatever ``start_patience`` is, where it is set).
+FAR_FROM_START = 20.0
+EARLY_PATIENCE = 3
 
 
 def _group_shapes(parameter_groups, parameters, device) -> list[torch.Tensor]:
@@ -146,8 +154,10 @@ class Trainer:
         Relative improvement that counts.
     start_patience : int or None, default=None
         Stop a group after this many epochs if its lowest loss since the first epoch is
-        still more than :data:`NEAR_START` times the first epoch's, keeping the first
-        epoch's parameters (see the module docstring; None: no such stop).
+        still more than :data:`NEAR_START` times the first epoch's, or after
+        :data:`EARLY_PATIENCE` epochs if it is more than :data:`FAR_FROM_START` times
+        it, keeping the first epoch's parameters (see the module docstring; None: no
+        such stop).
     cuda_graph : bool, default=False
         Capture the epoch in a CUDA graph and replay it (CUDA devices only).
     """
@@ -240,7 +250,9 @@ class Trainer:
         start.copy_(torch.where(first, value, start))
         low.copy_(torch.where(first, low, torch.minimum(low, value)))
         # the lowest loss only falls: a group back within NEAR_START is never stopped here
-        return (self.epoch + 1 >= patience) & (low > NEAR_START * start)
+        done = self.epoch + 1
+        near = (done >= patience) & (low > NEAR_START * start)
+        return near | ((done >= EARLY_PATIENCE) & (low > FAR_FROM_START * start))
 
     def run(
         self,
@@ -397,6 +409,18 @@ def progress_printer(method: str, n_epochs: int, verbose: bool | int):
     return report, every
 
 
+def far_from_start(history: np.ndarray) -> bool:
+    """Whether the groups that ran longest in ``history`` (epochs x groups, NaN once a
+    group stopped) all ended more than :data:`FAR_FROM_START` times their first loss,
+    within their lowest loss since: the early tier of ``start_patience`` stopped them."""
+    history = np.atleast_2d(np.asarray(history, dtype=float).T).T
+    last = history[-1]
+    longest = history[:, np.isfinite(last)]
+    if len(history) < EARLY_PATIENCE or longest.shape[1] == 0:
+        return False
+    return bool(np.all(np.nanmin(longest[1:], axis=0) > FAR_FROM_START * longest[0]))
+
+
 def early_stop_note(
     method: str,
     done: int,
@@ -405,8 +429,12 @@ def early_stop_note(
     n_iter_no_change,
     tol,
     start_patience=None,
+    history: np.ndarray | None = None,
 ) -> str | None:
-    """The ``verbose`` line of a run that stopped before ``n_epochs``, or None."""
+    """The ``verbose`` line of a run that stopped before ``n_epochs``, or None.
+
+    ``history``: the losses of the ``done`` epochs (epochs x groups), which tell the
+    early tier of ``start_patience`` from its main rule."""
     if done >= n_epochs or (n_iter_no_change is None and start_patience is None):
         return None
     kept = (
@@ -414,8 +442,14 @@ def early_stop_note(
         if len(best_epoch) == 1
         else f"each group's best epoch ({int(best_epoch.min())} to {int(best_epoch.max())})"
     )
+    early = start_patience is not None and EARLY_PATIENCE <= done < start_patience
+    if early and history is not None and far_from_start(history[:done]):
+        reason = (
+            f"after {done} epochs the loss was still more than {FAR_FROM_START:g} times "
+            "the start's"
+        )
     # the no-change counter cannot stop a group before n_iter_no_change + 1 epochs
-    if n_iter_no_change is None or done <= n_iter_no_change:
+    elif n_iter_no_change is None or done <= n_iter_no_change:
         reason = (
             f"within start_patience={start_patience} epochs the loss did not come back "
             f"within {NEAR_START:g} times the start's"
