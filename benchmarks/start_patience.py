@@ -13,16 +13,19 @@ the no-change stop lets it) and keeps each group's loss history:
   class) and ``rtw-default`` row (the default classifier's centroids), for each seed;
 * synthetic: ``make_warped_signals`` on R^1, S^1, S^3 and SPD(2), N = 4 and 30, T = 100,
   five data seeds, ``align``'s defaults;
-* long: 8 unit-quaternion series of 1,000 and 4,000 samples (the long-demonstrations
-  page's data), three seeds.
+* long: 8 unit-quaternion series of 1,000, 4,000 and 16,000 samples (the
+  long-demonstrations page's data), three seeds.
 
 The rule is then replayed on every history: after ``patience`` epochs a group whose lowest
 loss since the first epoch is more than ``near`` times the first epoch's stops and keeps
-the start. Because the rule only ends a group early (the trajectory up to its stop is the
-recorded one, also inside a batch), the replay gives exactly the epochs each group would
-run and the loss it would keep. Printed per data set and rule: the fraction of epochs run,
-the groups that would keep a worse loss than without the rule, and the worst such loss
-ratio. For the synthetic sets, whose clean signal is known, a second table scores the
+the start. A second table adds the rule's early tier to the default (``patience`` 8,
+``near`` 2.5): after ``early`` epochs a group still more than ``far`` times the start's
+stops too; the trainer's tier is ``EARLY_PATIENCE``, ``FAR_FROM_START``. Because the
+rule only ends a group early (the trajectory up to its stop is the recorded one, also
+inside a batch), the replay gives exactly the epochs each group would run and the loss it
+would keep. Printed per data set and rule: the fraction of epochs run, the groups that
+would keep a worse loss than without the rule, and the worst such loss ratio. For the
+synthetic sets, whose clean signal is known, a third table scores the
 default (``start_patience`` as the preset sets it) and a shorter rule (:data:`CUT`)
 against training to the end by the mean's DTW distance to that signal, next to the
 spread of training seeds. ``--out`` keeps what was recorded (JSON); ``--replay`` reads an
@@ -42,26 +45,44 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the repository; 
 import numpy as np
 
 from benchmarks._shared import check_writable
+from sk_rtw.align._training import EARLY_PATIENCE, FAR_FROM_START
 
 #: Rules replayed: ``start_patience`` values and multiples of the start's loss.
 PATIENCES = (4, 6, 8, 10)
 NEARS = (1.5, 2.0, 2.5, 3.0)
+#: Early tiers replayed with the default rule: (epochs, multiple of the start's loss).
+EARLY_TIERS = (None, (2, 20.0), (3, 5.0), (3, 10.0), (3, 20.0), (3, 50.0), (4, 10.0),
+               (4, 20.0))  # fmt: skip
+#: The default rule the early tiers are added to.
+DEFAULT_RULE = (8, 2.5)
 
 
-def stop_epoch(history: np.ndarray, patience: int, near: float) -> int:
-    """Epochs a group runs under the rule (the whole history where it never fires)."""
-    for epoch in range(patience - 1, len(history)):
-        if np.nanmin(history[1 : epoch + 1]) > near * history[0]:
-            return epoch + 1
+def stop_epoch(
+    history: np.ndarray, patience: int, near: float, early: tuple[int, float] | None = None
+) -> int:
+    """Epochs a group runs under the rule (the whole history where it never fires);
+    ``early``: the tier ``(epochs, far)`` that stops a group still more than ``far``
+    times the start's loss after ``epochs`` epochs."""
+    for epoch in range(1, len(history)):
+        low, done = np.nanmin(history[1 : epoch + 1]), epoch + 1
+        if done >= patience and low > near * history[0]:
+            return done
+        if early is not None and done >= early[0] and low > early[1] * history[0]:
+            return done
     return len(history)
 
 
-def replay(histories: list[np.ndarray], patience: int, near: float) -> tuple[float, int, float]:
+def replay(
+    histories: list[np.ndarray],
+    patience: int,
+    near: float,
+    early: tuple[int, float] | None = None,
+) -> tuple[float, int, float]:
     """Fraction of the epochs run, groups keeping a worse loss, the worst loss ratio."""
     run = full = losing = 0
     worst = 1.0
     for history in histories:
-        stop = stop_epoch(history, patience, near)
+        stop = stop_epoch(history, patience, near, early)
         run, full = run + stop, full + len(history)
         kept, best = np.nanmin(history[:stop]), np.nanmin(history)
         if kept > best:
@@ -175,7 +196,7 @@ def long_histories() -> list[list[float]]:
     from sk_rtw.datasets import make_warped_signals
 
     out = []
-    for length in (1000, 4000):
+    for length in (1000, 4000, 16000):
         for seed in range(3):
             X = np.asarray(make_warped_signals("quaternion", 8, length, random_state=seed).signals)
             result = align(X, manifold="quaternion", random_state=seed, start_patience=None)
@@ -241,6 +262,18 @@ def print_rules(sets: dict[str, list[list[float]]]) -> None:
                 fraction, losing, worst = replay(histories, patience, near)
                 cells.append(f"{fraction:.2f}, {losing}, {worst:.3f}")
             print(f"| patience {patience}, near {near:g} | " + " | ".join(cells) + " |")
+    patience, near = DEFAULT_RULE
+    print(f"\nThe early tier added to patience {patience}, near {near:g} (the trainer's: "
+          f"{EARLY_PATIENCE} epochs, {FAR_FROM_START:g} times):\n")  # fmt: skip
+    print("| early tier | " + " | ".join(sets) + " |")
+    print("| --- |" + " --- |" * len(sets))
+    for early in EARLY_TIERS:
+        cells = []
+        for histories in arrays.values():
+            fraction, losing, worst = replay(histories, patience, near, early)
+            cells.append(f"{fraction:.2f}, {losing}, {worst:.3f}")
+        name = "none" if early is None else f"after {early[0]}, far {early[1]:g}"
+        print(f"| {name} | " + " | ".join(cells) + " |")
 
 
 if __name__ == "__main__":
