@@ -28,6 +28,12 @@ machine's noise is large, so compare the printed ratios, not absolute seconds):
     RTW on the real pose demonstrations at full resolution (``--shared-data``, R^3 x S^3):
     carrot grating (12 demonstrations of 2,322-3,371 samples) and circular wiping (4 of
     1,096-1,457), seconds and peak resident memory, each in a fresh process.
+``budget``
+    where the default fit of N = 30 Euclidean series of T = 100 spends its time, one
+    thread: the setup (``n_epochs=0``: checks, DTW start, final mean), the epochs of the
+    width-512 network and of a width-8 one (``(fit(32 epochs) - setup) / 32``, early
+    stopping off), and what 3x aeon's DBA would leave per epoch for everything but the
+    network at the epochs the default runs.
 ``busy``
     a default fit while another process keeps one core busy with numerical work, against
     the same fit on a quiet machine (and with torch's default threads, the old behaviour);
@@ -50,7 +56,7 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-SECTIONS = ("fits", "epochs", "estimators", "poses", "busy")
+SECTIONS = ("fits", "epochs", "budget", "estimators", "poses", "busy")
 
 #: Runs in every probe process: timing helpers and the warped signals.
 PRELUDE = """
@@ -238,6 +244,35 @@ def section_epochs(args) -> None:
             print(f"| {name} | {n} | " + " | ".join(f"{v:.2f}" for v in row) + " |", flush=True)
 
 
+def section_budget(args) -> None:
+    print("\n## Where the default N = 30, T = 100 fit spends its time (1 thread)\n")
+    dba = aeon_dba(1, args.repeats)
+    default = engine_fit("euclidean", 30, "rtw", 1, args.repeats, args.device)
+    epochs = default["epochs"]
+    per_epoch = {}
+    setup = {}
+    for width in (512, 8):
+        options = {"hidden_size": width}
+        setup[width] = engine_fit("euclidean", 30, "rtw", 1, args.repeats, args.device,
+                                  n_epochs=0, **options)["seconds"]  # fmt: skip
+        full = engine_fit("euclidean", 30, "rtw", 1, args.repeats, args.device, n_epochs=32,
+                          n_iter_no_change=None, start_patience=None, **options)  # fmt: skip
+        per_epoch[width] = (full["seconds"] - setup[width]) / 32
+    network = per_epoch[512] - per_epoch[8]
+    rest = (3 * dba - setup[512]) / epochs - network
+    print(
+        "| aeon DBA (s) | RTW default (s) | epochs | setup (s) | ms per epoch, width 512 "
+        "| width 8 | the network's share | ms per epoch left for the rest at 3x DBA |"
+    )
+    print("| --- | --- | --- | --- | --- | --- | --- | --- |")
+    print(
+        f"| {dba:.3f} | {default['seconds']:.3f} ({default['seconds'] / dba:.2f}x) | {epochs} "
+        f"| {setup[512]:.3f} | {per_epoch[512] * 1e3:.2f} | {per_epoch[8] * 1e3:.2f} "
+        f"| {network * 1e3:.2f} | **{rest * 1e3:.2f}** (against {per_epoch[8] * 1e3:.2f}) |",
+        flush=True,
+    )
+
+
 ESTIMATORS = """
 import warnings
 import torch
@@ -404,7 +439,7 @@ def main(argv=None) -> None:
     if args.cuda_graph:
         EXTRA_OPTIONS["cuda_graph"] = True
     print(f"machine: {machine(args.device)}" + (", CUDA graphs" if args.cuda_graph else ""))
-    sections = {"fits": section_fits, "epochs": section_epochs,
+    sections = {"fits": section_fits, "epochs": section_epochs, "budget": section_budget,
                 "estimators": section_estimators, "poses": section_poses,
                 "busy": section_busy}  # fmt: skip
     for name in args.sections:
