@@ -10,7 +10,9 @@ multiplication of two such tensors takes 3-5x the time it takes in reused memory
 from 64,000 to 256,000 samples (2.4 to 19.2 s; 1.6 to 7.5 s, 4.8x, with the heap kept).
 
 :func:`heap_for_temporaries` keeps such blocks in the heap for the duration of a
-fit (``M_MMAP_MAX = 0``, ``M_TRIM_THRESHOLD`` out of reach) and afterwards gives the free
+fit (``M_MMAP_MAX = 0``, trimming off: ``M_TRIM_THRESHOLD = -1``; the largest positive
+threshold, 2**31 - 1 bytes, is below what a 256,000-sample epoch frees at once, and the
+pages trimmed were faulted in again in the next epoch) and afterwards gives the free
 heap back to the system (``malloc_trim``) and leaves the allocator where its own adaptive
 rule ends for a program with large arrays (mmap threshold 32 MB, trim threshold 64 MB,
 mmap allowed again). Only fits whose temporaries exceed :data:`LARGE_TEMPORARY` bytes
@@ -78,7 +80,7 @@ def heap_for_temporaries(temporary_bytes: float):
     with _lock:
         if _holders == 0:
             libc.mallopt(_M_MMAP_MAX, 0)
-            libc.mallopt(_M_TRIM_THRESHOLD, 2**31 - 1)
+            libc.mallopt(_M_TRIM_THRESHOLD, -1)  # mallopt(3): -1 disables trimming
         _holders += 1
     try:
         yield

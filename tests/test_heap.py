@@ -44,6 +44,26 @@ def test_a_large_fit_keeps_its_temporaries_in_the_heap_and_gives_them_back():
     assert _mmapped_bytes_of(16 * 2**20) == 0  # below the 32 MB threshold left behind
 
 
+def test_a_kept_heap_is_not_trimmed_however_much_is_freed():
+    """glibc trims the heap's free top once it exceeds the trim threshold, and mallopt's
+    largest positive threshold is 2**31 - 1 bytes: a 256,000-sample fit frees more than
+    that at the end of each epoch and faulted those pages in again in the next one. The
+    kept heap switches trimming off (mallopt(3): -1). The block is never touched, so it
+    takes address space, not memory."""
+    libc = _glibc()
+    if not hasattr(libc, "mallinfo2"):  # glibc < 2.33
+        pytest.skip("mallinfo2 needs glibc 2.33")
+    libc.mallinfo2.restype = _MallInfo2
+    nbytes = 2**31 + 2**27
+    with heap_for_temporaries(LARGE_TEMPORARY):
+        block = np.empty(nbytes // 8)
+        if libc.mallinfo2().hblkhd >= nbytes:  # the heap could not grow: glibc mmapped it
+            pytest.skip("no room for the heap to grow by 2 GB here")
+        del block
+        kept = libc.mallinfo2().keepcost  # the free top the heap could give back
+    assert kept >= nbytes
+
+
 def test_a_small_fit_leaves_the_allocator_alone():
     large = 128 * 2**20
     with heap_for_temporaries(LARGE_TEMPORARY - 1):
