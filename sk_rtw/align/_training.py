@@ -29,7 +29,7 @@ group follows exactly the trajectory of a separate fit. Per group the loop keeps
   A group still *far* from its start stops sooner: one whose lowest loss after
   :data:`EARLY_PATIENCE` epochs is more than :data:`FAR_FROM_START` times the start's
   (the same replays: no group that went on to beat its start was above 7.2 times it
-  after two epochs; long demonstrations were 23-2,200 times above it).
+  after two epochs; long demonstrations were 23-375 times above it).
 
 A caller may pause the loop (``run(pause=...)``) and continue with the running groups
 only (:meth:`Trainer.narrow`): best iterates, counters, history and Adam's moments are
@@ -409,10 +409,10 @@ def progress_printer(method: str, n_epochs: int, verbose: bool | int):
     return report, every
 
 
-def far_from_start(history: np.ndarray) -> bool:
-    """Whether the groups that ran longest in ``history`` (epochs x groups, NaN once a
-    group stopped) all ended more than :data:`FAR_FROM_START` times their first loss,
-    within their lowest loss since: the early tier of ``start_patience`` stopped them."""
+def stopped_far_from_start(history: np.ndarray) -> bool:
+    """Whether the early tier of ``start_patience`` stopped the groups that ran longest in
+    ``history`` (epochs x groups, NaN once a group stopped): each one's lowest loss after
+    its first epoch still more than :data:`FAR_FROM_START` times the first epoch's."""
     history = np.atleast_2d(np.asarray(history, dtype=float).T).T
     last = history[-1]
     longest = history[:, np.isfinite(last)]
@@ -443,7 +443,7 @@ def early_stop_note(
         else f"each group's best epoch ({int(best_epoch.min())} to {int(best_epoch.max())})"
     )
     early = start_patience is not None and EARLY_PATIENCE <= done < start_patience
-    if early and history is not None and far_from_start(history[:done]):
+    if early and history is not None and stopped_far_from_start(history[:done]):
         reason = (
             f"after {done} epochs the loss was still more than {FAR_FROM_START:g} times "
             "the start's"
