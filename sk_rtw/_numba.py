@@ -18,6 +18,8 @@ from __future__ import annotations
 import contextlib
 import os
 import threading
+import types
+from collections.abc import Callable
 from typing import Any
 
 import numba
@@ -80,9 +82,30 @@ def row_builds(functions: dict, **options) -> dict:
     """Each kernel over rows (a ``prange`` loop) compiled twice, serial and threaded, by
     name: what :func:`launch_rows` launches."""
     return {
-        name: (numba.njit(**options)(function), numba.njit(**options, parallel=True)(function))
+        name: (serial_build(function, **options), numba.njit(**options, parallel=True)(function))
         for name, function in functions.items()
     }
+
+
+def serial_build(function: Callable[..., Any], **options) -> Any:
+    """``function`` (a ``prange`` kernel) compiled without threads, beside its threaded
+    build.
+
+    numba's on-disk cache names an entry by the function's module, qualified name and
+    line, and keys it by signature: the ``parallel`` flag is not part of it. Two builds
+    of one function with ``cache=True`` therefore share one entry, and whichever compiled
+    first is loaded for the other in the next process (a "serial" build that launches
+    threads, or the reverse). The serial build is a copy of the function under its own
+    qualified name, so it has a cache entry of its own.
+    """
+    copy = types.FunctionType(
+        function.__code__, function.__globals__, function.__name__, function.__defaults__,
+        function.__closure__,
+    )  # fmt: skip
+    copy.__qualname__ = f"{function.__qualname__}__serial"
+    copy.__module__ = function.__module__
+    copy.__doc__ = function.__doc__
+    return numba.njit(**options)(copy)
 
 
 def launch_rows(builds: dict, name: str, threshold: int, *arrays) -> None:

@@ -160,3 +160,49 @@ def test_thread_map_keeps_the_order_and_runs_side_by_side():
     assert results[0][1] != results[1][1]
     serial = thread_map(lambda item: (item, threading.get_ident()), range(5), n_threads=1)
     assert serial == [(k, threading.get_ident()) for k in range(5)]
+
+
+def test_the_serial_and_threaded_builds_of_a_kernel_have_their_own_cache_entries(tmp_path):
+    """numba's disk cache keys an entry by function and signature, not by ``parallel``:
+    two plain builds of one function share it, and the second build loads the first's
+    code (the "threaded" kernel then runs on one thread). The threaded build of
+    :func:`row_builds` must use more than one thread, in the process that compiles it and
+    in the next one that loads it from the cache; the serial one must use one."""
+    module = tmp_path / "kernel_module.py"
+    module.write_text(
+        textwrap.dedent(
+            """
+            import numpy as np
+            from numba import prange
+            from sk_rtw._numba import row_builds
+
+            def work(out):
+                for i in prange(out.shape[0]):
+                    total = 0.0
+                    for k in range(300000):
+                        total += k * 1e-12
+                    out[i] = total
+
+            BUILDS = row_builds({"work": work}, cache=True, nogil=True)
+            """
+        )
+    )
+    code = """
+        import sys, time, numba, numpy as np
+        sys.path.insert(0, %r)
+        import kernel_module
+        serial, threaded = kernel_module.BUILDS["work"]
+        numba.set_num_threads(2)
+        out = np.empty(400)
+        serial(out[:2]); threaded(out[:2])  # compile (or load) first
+        timings = []
+        for kernel in (serial, threaded) * 3:
+            start = time.perf_counter(); kernel(out); timings.append(time.perf_counter() - start)
+        print(min(timings[0::2]) / min(timings[1::2]))
+    """ % str(tmp_path)
+    if (os.cpu_count() or 1) < 2:
+        pytest.skip("needs two cores to tell a threaded kernel from a serial one")
+    for _ in range(2):  # the second process loads both builds from the cache
+        result = run_python(code, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+        assert result.returncode == 0, result.stderr[-2000:]
+        assert float(result.stdout.split()[-1]) > 1.4, result.stdout
