@@ -311,7 +311,7 @@ def test_pairwise_distances_with_bounds_equal_those_without(rng):
         for scale in (1.0, 1.5, 0.5, 0.0):
             bounds = plain * scale + (rng.random(plain.shape) * 1e-3 if scale else 0.0)
             got = _pruned.pairwise_segments(X, lengths, X, lengths, segments, True, w, True,
-                                             bounds)  # fmt: skip
+                                             bounds, 0.0)  # fmt: skip
             np.testing.assert_array_equal(got, plain)
     low = plain[0, 1] * 0.5
     assert _pruned.pruned_distance(X[0], X[1], segments, True, -1.0, low) > low

@@ -18,7 +18,7 @@ def one_pair_kernel(X, Y, manifold, window, squared):
     return _pruned.pairwise_segments(
         _point_costs.kernel_series(cx), cx.lengths, _point_costs.kernel_series(cy), cy.lengths,
         _point_costs.segment_codes(cx.manifold), squared, _dtw.check_window(window), symmetric,
-        np.full((cx.n_series, cy.n_series), np.inf),
+        np.full((cx.n_series, cy.n_series), np.inf), 0.0,
     )  # fmt: skip
 
 

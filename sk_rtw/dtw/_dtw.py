@@ -17,7 +17,7 @@ from .._numba import numba_threads
 from .._threads import thread_map
 from ..manifolds import Manifold
 from ..utils import SeriesCollection, check_series, check_series_collection
-from ..utils._common_params import DTW_WINDOW
+from ..utils._common_params import DTW_WINDOW, WARP_PENALTY
 from . import _kernels, _lanes, _point_costs, _pruned
 from ._band import EXACT_CELLS, guide_bound
 from ._costs import check_costs, kernel_form, point_cost_matrix
@@ -44,6 +44,30 @@ def check_window(window: float | None, name: str = "window") -> float:
     """
     value = DTW_WINDOW.check(window, name)
     return -1.0 if value is None else float(value)
+
+
+def check_warp_penalty(warp_penalty: float, normalize: str | None = None) -> float:
+    """Check amerced DTW's penalty (a finite float, at least 0) and return it as a float.
+
+    Parameters
+    ----------
+    warp_penalty : float
+        The penalty.
+    normalize : {None, "path"}, optional
+        The distance's normalisation: a penalty is refused with ``"path"`` (the path's
+        length is DTW's, not amerced DTW's).
+
+    Returns
+    -------
+    penalty : float
+    """
+    value = WARP_PENALTY.check(warp_penalty)
+    if value > 0 and normalize == "path":
+        raise ValueError(
+            'normalize="path" divides by the steps of the optimal DTW path; it is not '
+            "defined for amerced DTW: use warp_penalty=0 or normalize=None"
+        )
+    return float(value)
 
 
 def _check_normalize(normalize: str | None) -> None:
@@ -116,6 +140,7 @@ def dtw_distance(
     window: float | None = None,
     squared: bool = False,
     normalize: str | None = None,
+    warp_penalty: float = 0.0,
 ) -> float:
     """DTW distance between two series on a manifold.
 
@@ -131,11 +156,16 @@ def dtw_distance(
         Use the squared geodesic distance as point cost (aeon's Euclidean convention).
     normalize : {None, "path"}, default=None
         ``"path"`` divides the accumulated cost by the number of steps of the optimal path.
+    warp_penalty : float, default=0.0
+        Amerced DTW (Herrmann and Webb, 2023): this penalty is added for every step of the
+        path off the diagonal (a repeated sample of either series). 0 is DTW; a large
+        penalty approaches the direct alignment of equal-length series. In the units of
+        the point cost (squared with ``squared=True``).
 
     Returns
     -------
     float
-        Accumulated point cost along the optimal warping path.
+        Accumulated point cost along the optimal warping path (plus its penalties).
 
     Examples
     --------
@@ -145,6 +175,7 @@ def dtw_distance(
     """
     _check_normalize(normalize)
     w = check_window(window)
+    penalty = check_warp_penalty(warp_penalty, normalize)
     x, y, manifold = _pair(x, y, manifold)
     if normalize == "path":
         path, cost = path_indices(x, y, manifold, w, squared)
@@ -152,14 +183,14 @@ def dtw_distance(
     segments = _point_costs.segment_codes(manifold)
     if segments is None:
         return float(_kernels.final_cost(point_cost_matrix(x, y, manifold, squared),
-                                         len(x), len(y), w))  # fmt: skip
+                                         len(x), len(y), w, penalty))  # fmt: skip
     # two rows of memory; long pairs without a band skip the cells that cannot beat their
-    # coarse-to-fine path (the same value)
-    bound = guide_bound(x, y, manifold, w, squared)
+    # coarse-to-fine path (the same value; the path's cost bounds DTW, not amerced DTW)
+    bound = guide_bound(x, y, manifold, w, squared) if penalty == 0 else np.inf
     fx, fy = kernel_form(x, manifold), kernel_form(y, manifold)
-    value = _pruned.pruned_distance(fx, fy, segments, squared, w, bound)
+    value = _pruned.pruned_distance(fx, fy, segments, squared, w, bound, penalty)
     if not value <= bound:
-        value = _pruned.pruned_distance(fx, fy, segments, squared, w, np.inf)
+        value = _pruned.pruned_distance(fx, fy, segments, squared, w, np.inf, penalty)
     return float(value)
 
 
@@ -200,6 +231,7 @@ def dtw_pairwise_distance(
     squared: bool = False,
     normalize: str | None = None,
     n_jobs: int | None = None,
+    warp_penalty: float = 0.0,
 ) -> np.ndarray:
     """DTW distances between all series of ``X`` and all series of ``Y`` (or ``X``).
 
@@ -209,7 +241,7 @@ def dtw_pairwise_distance(
         ``(n, T)``, ``(n, T, *point_shape)`` or a list of unequal-length series.
     Y : same forms as ``X``, optional
         Defaults to ``X`` (then only the upper triangle is computed).
-    manifold, window, squared, normalize
+    manifold, window, squared, normalize, warp_penalty
         As in :func:`dtw_distance`.
     n_jobs : int, optional
         Threads for the pairs (numba); ``-1`` uses all cores. Default: 1.
@@ -227,6 +259,7 @@ def dtw_pairwise_distance(
     """
     _check_normalize(normalize)
     w = check_window(window)
+    penalty = check_warp_penalty(warp_penalty, normalize)
     cx = (
         X
         if isinstance(X, SeriesCollection)
@@ -242,7 +275,7 @@ def dtw_pairwise_distance(
             else check_series_collection(Y, cx.manifold, name="Y", min_length=1)
         )
     with numba_threads(n_jobs):
-        return _pairwise(cx, cy, w, squared, symmetric, normalize == "path")
+        return _pairwise(cx, cy, w, squared, symmetric, normalize == "path", penalty)
 
 
 def _in_lanes(flat_x, lx, flat_y, ly, segments, squared, window, symmetric) -> np.ndarray:
@@ -268,15 +301,22 @@ def _in_lanes(flat_x, lx, flat_y, ly, segments, squared, window, symmetric) -> n
 
 
 def _pairwise(
-    cx: SeriesCollection, cy: SeriesCollection, window, squared, symmetric, per_step
-) -> np.ndarray:
+    cx: SeriesCollection, cy: SeriesCollection, window, squared, symmetric, per_step,
+    penalty=0.0,
+) -> np.ndarray:  # fmt: skip
     """The distances of :func:`dtw_pairwise_distance` (long pairs without a band skip the
-    cells that cannot beat their coarse-to-fine path: :func:`_guide_bounds`)."""
+    cells that cannot beat their coarse-to-fine path: :func:`_guide_bounds`; amerced DTW
+    one pair at a time, no guide)."""
     manifold = cx.manifold
     segments = _point_costs.segment_codes(manifold)
     if segments is not None:
         flat_x = _point_costs.kernel_series(cx)
         flat_y = _point_costs.kernel_series(cy)
+        if not per_step and penalty > 0:
+            return _pruned.pairwise_segments(
+                flat_x, cx.lengths, flat_y, cy.lengths, segments, squared, window, symmetric,
+                np.full((cx.n_series, cy.n_series), np.inf), penalty,
+            )  # fmt: skip
         if not per_step:
             bounds = _guide_bounds(cx, cy, window, squared, symmetric)
             n_pairs = cx.n_series * (cx.n_series - 1) // 2 if symmetric else bounds.size
@@ -286,7 +326,7 @@ def _pairwise(
                                  window, symmetric)  # fmt: skip
             return _pruned.pairwise_segments(
                 flat_x, cx.lengths, flat_y, cy.lengths, segments, squared, window, symmetric,
-                bounds,
+                bounds, 0.0,
             )  # fmt: skip
     # Cost matrices for a block of pairs at a time (numba for the known point distances,
     # the vectorised geometry otherwise), then the parallel recursion over the block.
@@ -322,6 +362,7 @@ def _pairwise(
                 cy.lengths[chunk],
                 window,
                 per_step,
+                penalty,
             )
     if symmetric:
         values = np.triu(values, 1) + np.triu(values, 1).T

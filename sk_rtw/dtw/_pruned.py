@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from ._kernels import _band_row, _cell, _two_rows, choose_step, sakoe_chiba_rows
+from ._kernels import _amerced_cell, _band_row, _cell, _two_rows, choose_step, sakoe_chiba_rows
 from ._point_costs import _cost_row
 
 _INF = np.inf
@@ -27,10 +27,12 @@ PRUNE_CHUNK = 32
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _pruned_row(x, y, i, prev, cur, costs, lo, hi, reach, bound, segments, squared):
+def _pruned_row(x, y, i, prev, cur, costs, lo, hi, reach, bound, segments, squared, penalty):
     """Row ``i`` of the accumulated cost into ``cur`` (padded as in :func:`_accumulate_row`)
     from column ``lo`` on, skipping what cannot beat ``bound`` (PrunedDTW: Silva and
-    Batista, 2016). ``costs`` is a scratch row of at least ``hi`` entries.
+    Batista, 2016). ``costs`` is a scratch row of at least ``hi`` entries; ``penalty`` is
+    amerced DTW's (:func:`~._kernels._cell`: a non-negative penalty keeps every argument
+    below).
 
     A cell is "kept" when its accumulated cost is at most ``bound``. ``reach`` is the last
     kept column of the row above plus one: past it the cells above and above-left exceed
@@ -40,7 +42,7 @@ def _pruned_row(x, y, i, prev, cur, costs, lo, hi, reach, bound, segments, squar
     """
     if bound == _INF:  # nothing to skip: the plain recursion
         _cost_row(x, y[lo:hi], i, hi - lo, segments, squared, costs[lo:hi])
-        _band_row(costs, prev, cur, lo, hi)
+        _band_row(costs, prev, cur, lo, hi, penalty)
         return lo, hi - 1, hi - 1
     left = _INF
     first, last = -1, -1
@@ -48,7 +50,10 @@ def _pruned_row(x, y, i, prev, cur, costs, lo, hi, reach, bound, segments, squar
         stop = min(hi, chunk + PRUNE_CHUNK)
         _cost_row(x, y[chunk:stop], i, stop - chunk, segments, squared, costs[chunk:stop])
         for j in range(chunk, stop):
-            left = _cell(prev, left, j, costs[j])
+            if penalty == 0.0:
+                left = _cell(prev, left, j, costs[j])
+            else:
+                left = _amerced_cell(prev, left, j, costs[j], penalty)
             cur[j + 1] = left
             if left <= bound:
                 if first < 0:
@@ -78,7 +83,7 @@ def accumulated_segment_cost(x, y, segments, squared, window, bound):
     in ``values[offsets[i]:offsets[i + 1]]`` (:func:`ragged_value` reads a cell).
     """
     lo, hi = sakoe_chiba_rows(x.shape[0], y.shape[0], window)
-    return _pruned_rows(x, y, segments, squared, lo, hi, bound, True)[:3]
+    return _pruned_rows(x, y, segments, squared, lo, hi, bound, True, 0.0)[:3]
 
 
 @njit(cache=True, nogil=True)
@@ -87,7 +92,7 @@ def band_segment_cost(x, y, segments, squared, lo, hi):
     ``lo[i] <= j < hi[i]`` (``lo`` and ``hi`` non-decreasing, ``lo[0] = 0``,
     ``hi[-1] = len(y)``), every cell of it computed; the same ``(values, offsets,
     starts)`` rows."""
-    return _pruned_rows(x, y, segments, squared, lo, hi, _INF, True)[:3]
+    return _pruned_rows(x, y, segments, squared, lo, hi, _INF, True, 0.0)[:3]
 
 
 @njit(cache=True, nogil=True)
@@ -103,18 +108,18 @@ def band_accumulated_cost(costs, lo, hi):
     for i in range(nx):
         offsets[i + 1] = offsets[i] + hi[i] - lo[i]
         row[lo[i] : hi[i]] = costs[offsets[i] : offsets[i + 1]]
-        _band_row(row, prev, cur, lo[i], hi[i])
+        _band_row(row, prev, cur, lo[i], hi[i], 0.0)
         values[offsets[i] : offsets[i + 1]] = cur[lo[i] + 1 : hi[i] + 1]
         prev, cur = cur, prev
     return values, offsets, lo.copy()
 
 
 @njit(cache=True, nogil=True)
-def pruned_distance(x, y, segments, squared, window, bound):
+def pruned_distance(x, y, segments, squared, window, bound, penalty=0.0):
     """The DTW distance of flattened series ``x`` and ``y`` in two rows of memory, the
     cells that cannot beat ``bound`` skipped as in :func:`accumulated_segment_cost`:
     exact when at most ``bound``, otherwise some value above it (``inf`` if the bound
-    was too low)."""
+    was too low). ``penalty``: amerced DTW's, on every step off the diagonal (0: DTW)."""
     if bound == _INF:  # the plain recursion, without the pruning's bookkeeping per row
         lo, hi = sakoe_chiba_rows(x.shape[0], y.shape[0], window)
         prev, cur = _two_rows(y.shape[0])
@@ -122,18 +127,18 @@ def pruned_distance(x, y, segments, squared, window, bound):
         for i in range(x.shape[0]):
             _cost_row(x, y[lo[i] : hi[i]], i, hi[i] - lo[i], segments, squared,
                       costs[lo[i] : hi[i]])  # fmt: skip
-            _band_row(costs, prev, cur, lo[i], hi[i])
+            _band_row(costs, prev, cur, lo[i], hi[i], penalty)
             prev, cur = cur, prev
         return prev[y.shape[0]]
     lo, hi = sakoe_chiba_rows(x.shape[0], y.shape[0], window)
-    return _pruned_rows(x, y, segments, squared, lo, hi, bound, False)[3]
+    return _pruned_rows(x, y, segments, squared, lo, hi, bound, False, penalty)[3]
 
 
 @njit(cache=True, nogil=True)
-def _pruned_rows(x, y, segments, squared, lo, hi, bound, store):
+def _pruned_rows(x, y, segments, squared, lo, hi, bound, store, penalty):
     """Rows of the accumulated cost in two buffers, each kept in ``values`` if ``store``:
     ``(values, offsets, starts, last cell)`` (see :func:`accumulated_segment_cost`), in
-    the staircase band ``[lo[i], hi[i])``."""
+    the staircase band ``[lo[i], hi[i])``, off-diagonal steps amerced by ``penalty``."""
     nx, ny = x.shape[0], y.shape[0]
     prev, cur = _two_rows(ny)
     costs = np.empty(ny)
@@ -147,7 +152,7 @@ def _pruned_rows(x, y, segments, squared, lo, hi, bound, store):
         a = max(lo[i], start)
         cur[a] = _INF  # column a - 1, which the next row reads and this one does not write
         first, last, written = _pruned_row(
-            x, y, i, prev, cur, costs, a, hi[i], reach, bound, segments, squared
+            x, y, i, prev, cur, costs, a, hi[i], reach, bound, segments, squared, penalty
         )
         for k in range(written + 2, cur_end + 1):  # what two rows ago left further right
             cur[k] = _INF
@@ -211,14 +216,15 @@ def ragged_backtrack(values, offsets, starts, ny):
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def pairwise_segments(X, lx, Y, ly, segments, squared, window, symmetric, bounds):
+def pairwise_segments(X, lx, Y, ly, segments, squared, window, symmetric, bounds, penalty):
     """DTW between every series of ``X`` and of ``Y``, the cost rows computed in numba.
 
     Each cost row is computed just before the recursion consumes it, so the cost matrix
     never leaves the cache, and only within the band: a narrow band costs its width.
     ``bounds[i, j]`` is the cost of some path between the pair (``inf``: none known); the
     cells that cannot beat it are skipped (:func:`pruned_distance`; the pair is computed
-    again without it if it was too low). Returns the distances, shape ``(len(X), len(Y))``.
+    again without it if it was too low); ``penalty`` is amerced DTW's. Returns the
+    distances, shape ``(len(X), len(Y))``.
     """
     n, m = X.shape[0], Y.shape[0]
     values = np.zeros((n, m))
@@ -228,9 +234,9 @@ def pairwise_segments(X, lx, Y, ly, segments, squared, window, symmetric, bounds
         if symmetric and j <= i:
             continue
         x, y = X[i, : lx[i]], Y[j, : ly[j]]
-        value = pruned_distance(x, y, segments, squared, window, bounds[i, j])
+        value = pruned_distance(x, y, segments, squared, window, bounds[i, j], penalty)
         if not value <= bounds[i, j]:
-            value = pruned_distance(x, y, segments, squared, window, _INF)
+            value = pruned_distance(x, y, segments, squared, window, _INF, penalty)
         values[i, j] = value
     if symmetric:
         for i in range(n):

@@ -41,11 +41,11 @@ from typing import Any
 import numpy as np
 from numba import njit, prange
 
-from .._numba import numba_threads
+from .._numba import numba_threads, serial_build
 from ..manifolds import Manifold
 from ..utils import SeriesCollection, check_series_collection
 from . import _kernels, _point_costs, _pruned
-from ._dtw import check_window, dtw_pairwise_distance
+from ._dtw import check_warp_penalty, check_window, dtw_pairwise_distance
 
 _INF = np.inf
 
@@ -168,10 +168,9 @@ def lb_keogh(y, lower, upper, segments, squared):
     return total
 
 
-@njit(cache=True, nogil=True, parallel=True)
-def nearest_by_class(
+def _nearest_by_class(
     Q, lq, R, lr, owners, n_classes, skip_reference, skip_class, limits, every_class,
-    segments, squared, window,
+    segments, squared, window, penalty,
 ):  # fmt: skip
     """DTW distance of every query to the nearest reference of every class (module
     docstring), the values of the exhaustive search.
@@ -181,8 +180,9 @@ def nearest_by_class(
     ``skip_reference[q]`` and the references of class ``skip_class[q]`` (-1: none), and
     distances above ``limits[q]``. With ``every_class`` every class's nearest distance is
     computed; otherwise only the nearest class's (and those tied with it), the others
-    left ``inf``. Returns the distances ``(n_q, n_classes)`` (``inf`` where none was
-    wanted or left) and the number of exact DTWs computed per query.
+    left ``inf``. ``penalty`` is amerced DTW's (0: DTW; LB_Keogh bounds both, a penalty
+    only adds to a path's cost). Returns the distances ``(n_q, n_classes)`` (``inf``
+    where none was wanted or left) and the number of exact DTWs computed per query.
     """
     n_q, n_r, p = Q.shape[0], R.shape[0], Q.shape[2]
     out = np.full((n_q, n_classes), _INF)
@@ -221,7 +221,7 @@ def nearest_by_class(
             if bound > threshold:
                 continue
             value = _pruned.pruned_distance(x, R[r, : lr[r]], segments, squared, window,
-                                             threshold)  # fmt: skip
+                                             threshold, penalty)  # fmt: skip
             computed[q] += 1
             if value <= threshold and value < best[c]:
                 best[c] = value
@@ -241,6 +241,12 @@ def nearest_by_class(
     return out, computed
 
 
+#: :func:`_nearest_by_class` threaded over the queries, and on the calling thread alone
+#: (for callers that run their own threads: the forest's trees).
+nearest_by_class = njit(cache=True, nogil=True, parallel=True)(_nearest_by_class)
+nearest_by_class_serial = serial_build(_nearest_by_class, cache=True, nogil=True)
+
+
 def dtw_nearest_distance(
     X: Any,
     Y: Any,
@@ -253,6 +259,7 @@ def dtw_nearest_distance(
     max_distance: Any = None,
     nearest_only: bool = False,
     n_jobs: int | None = None,
+    warp_penalty: float = 0.0,
 ) -> np.ndarray:
     """DTW distance from every series of ``X`` to the nearest series of ``Y`` in every
     group: ``dtw_pairwise_distance(X, Y)`` reduced by group, without computing every pair.
@@ -290,6 +297,9 @@ def dtw_nearest_distance(
         to its end.
     n_jobs : int, optional
         Threads over the series of ``X`` (numba); ``-1`` uses all cores. Default: 1.
+    warp_penalty : float, default=0.0
+        As in :func:`~sk_rtw.dtw.dtw_distance`: amerced DTW's penalty on every step off
+        the diagonal (the same bounds hold: a penalty only adds to a path's cost).
 
     Returns
     -------
@@ -306,14 +316,15 @@ def dtw_nearest_distance(
            [16.,  1.]])
     """
     return _nearest(X, Y, groups, manifold, window, squared, exclude, exclude_group,
-                    max_distance, nearest_only, n_jobs)[0]  # fmt: skip
+                    max_distance, nearest_only, n_jobs, warp_penalty)[0]  # fmt: skip
 
 
 def _nearest(X, Y, groups, manifold, window, squared, exclude, exclude_group, max_distance,
-             nearest_only, n_jobs):  # fmt: skip
+             nearest_only, n_jobs, warp_penalty=0.0):  # fmt: skip
     """:func:`dtw_nearest_distance` and the number of exact DTWs it computed per series
     of ``X`` (every pair's count for the exhaustive search)."""
     w = check_window(window)
+    penalty = check_warp_penalty(warp_penalty)
     cx = X if isinstance(X, SeriesCollection) else check_series_collection(
         X, manifold, name="X", min_length=1
     )
@@ -335,7 +346,7 @@ def _nearest(X, Y, groups, manifold, window, squared, exclude, exclude_group, ma
     segments = _point_costs.segment_codes(cx.manifold)
     if segments is None:
         distances = dtw_pairwise_distance(cx, cy, window=window, squared=squared,
-                                          n_jobs=n_jobs)  # fmt: skip
+                                          n_jobs=n_jobs, warp_penalty=penalty)  # fmt: skip
         rows = np.flatnonzero(skip >= 0)
         distances[rows, skip[rows]] = np.inf
         distances[skip_group[:, None] == owners[None, :]] = np.inf
@@ -349,7 +360,7 @@ def _nearest(X, Y, groups, manifold, window, squared, exclude, exclude_group, ma
         return nearest_by_class(
             _point_costs.kernel_series(cx), cx.lengths, _point_costs.kernel_series(cy), cy.lengths,
             owners, n_groups, skip,
-            skip_group, limits, not nearest_only, segments, bool(squared), w,
+            skip_group, limits, not nearest_only, segments, bool(squared), w, penalty,
         )  # fmt: skip
 
 

@@ -76,3 +76,9 @@ DTW_WINDOW = Parameter(
     "Sakoe-Chiba band of the DTW, its radius as a fraction of the shorter series' "
     "length; None: no band.",
 )
+WARP_PENALTY = Parameter(
+    "warp_penalty",
+    (Interval(float, 0.0),),
+    "Amerced DTW's penalty on every step off the diagonal, in the units of the point cost "
+    "(0: DTW).",
+)
