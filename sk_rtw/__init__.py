@@ -34,6 +34,7 @@ from .manifolds import (
     get_manifold,
 )
 from .methods import DBA, NTW, RTW, TTW
+from .representations import tangent_velocity
 from .statistics import AlignedStatistics, ConfidenceTube, aligned_statistics
 
 __version__ = "0.1.0.dev0"
@@ -76,4 +77,5 @@ __all__ = [
     "methods",
     "metrics",
     "statistics",
+    "tangent_velocity",
 ]

@@ -4,6 +4,8 @@ search."""
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 from aeon.distances import adtw_distance as aeon_adtw_distance
@@ -62,7 +64,7 @@ def test_the_penalty_moves_the_distance_from_dtw_to_the_direct_alignment(rng):
     direct = float(np.abs(x - y).sum())
     values = [dtw_distance(x, y, warp_penalty=w) for w in (0.0, 0.01, 0.1, 1.0, 10.0)]
     assert values[0] == dtw_distance(x, y)
-    assert all(a <= b for a, b in zip(values, values[1:], strict=False))
+    assert all(a <= b for a, b in itertools.pairwise(values))
     assert dtw_distance(x, y, warp_penalty=2 * direct) == pytest.approx(direct, rel=1e-12)
 
 

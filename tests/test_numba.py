@@ -187,9 +187,9 @@ def test_the_serial_and_threaded_builds_of_a_kernel_have_their_own_cache_entries
             """
         )
     )
-    code = """
+    code = f"""
         import sys, time, numba, numpy as np
-        sys.path.insert(0, %r)
+        sys.path.insert(0, {str(tmp_path)!r})
         import kernel_module
         serial, threaded = kernel_module.BUILDS["work"]
         numba.set_num_threads(2)
@@ -199,7 +199,7 @@ def test_the_serial_and_threaded_builds_of_a_kernel_have_their_own_cache_entries
         for kernel in (serial, threaded) * 3:
             start = time.perf_counter(); kernel(out); timings.append(time.perf_counter() - start)
         print(min(timings[0::2]) / min(timings[1::2]))
-    """ % str(tmp_path)
+    """
     if (os.cpu_count() or 1) < 2:
         pytest.skip("needs two cores to tell a threaded kernel from a serial one")
     for _ in range(2):  # the second process loads both builds from the cache

@@ -10,6 +10,7 @@ array of points has shape ``(*leading, *point_shape)``.
 from __future__ import annotations
 
 import functools
+import math
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
 from typing import Any, ClassVar
@@ -135,6 +136,12 @@ class Manifold(ABC):
         """
         return None
 
+    @property
+    def velocity_dim(self) -> int:
+        """Number of coordinates of :meth:`velocity`: by default those of an ambient
+        tangent vector, ``prod(point_shape)``."""
+        return math.prod(self.point_shape)
+
     # --------------------------------------------------------- torch geometry
     @abstractmethod
     def _exp(self, p: torch.Tensor, v: torch.Tensor) -> torch.Tensor: ...
@@ -159,6 +166,12 @@ class Manifold(ABC):
         metric induced by the embedding)."""
         _, v = torch.broadcast_tensors(p, v)
         return safe_norm(v.reshape(*v.shape[: v.ndim - self.point_ndim], -1))
+
+    def _velocity(self, p: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
+        """``log_p(x)`` in coordinates that compare across base points: by default the
+        ambient tangent vector, flattened (:meth:`velocity`)."""
+        v = self._log(p, x)
+        return v.reshape(*v.shape[: v.ndim - self.point_ndim], -1)
 
     def _project(self, x: torch.Tensor) -> torch.Tensor:
         raise NotImplementedError(f"{type(self).__name__} defines no projection onto itself")
@@ -301,6 +314,42 @@ class Manifold(ABC):
                 f"{self!r}, got shape {tuple(c.shape)}"
             )
         return self._from_coordinates(p, c.to(dtype=p.dtype, device=p.device))
+
+    @checked_geometry(points=("p", "x"))
+    def velocity(self, p, x):
+        """The step from ``p`` to ``x``, ``log_p(x)``, in coordinates that compare across
+        base points: what a series' tangent velocity is made of
+        (:func:`sk_rtw.tangent_velocity`).
+
+        :meth:`log` gives a vector of the tangent space at ``p``; two such vectors at
+        different points are not comparable as they are. Each space gives its steps in a
+        frame that does not depend on where they start, so that the velocities of two
+        series (or of one series at two times) can be compared as Euclidean vectors:
+
+        * Euclidean: ``x - p``;
+        * sphere S^1: the signed angle, counter-clockwise positive (the circle's own
+          frame); S^d, d >= 2: the ambient tangent vector in R^(d+1) (no continuous
+          frame exists on S^2; an ambient vector is rotation-equivariant and keeps the
+          geodesic length as its norm);
+        * unit quaternions: the body angular velocity ``2 log(p^-1 x)`` in R^3 (the
+          rotation vector of the relative rotation, sign ambiguity resolved: its norm is
+          the rotation angle, twice :meth:`dist`);
+        * SPD(k): ``logm(p^-1/2 x p^-1/2)`` in isometric coordinates (diagonal and
+          sqrt(2) x upper triangle, ``k (k + 1) / 2`` numbers; norm = :meth:`dist`);
+        * products: each factor's, concatenated;
+        * a space of your own: the ambient :meth:`log`, flattened, unless it defines
+          ``_velocity`` and :attr:`velocity_dim`.
+
+        Parameters
+        ----------
+        p : array-like or torch.Tensor, shape (..., *point_shape)
+        x : array-like or torch.Tensor, shape (..., *point_shape)
+
+        Returns
+        -------
+        v : same type as the input, shape (..., velocity_dim)
+        """
+        return self._velocity(p, x)
 
     @checked_geometry(points=("A", "B"), broadcast=False)
     def pairwise_dist(self, A, B):

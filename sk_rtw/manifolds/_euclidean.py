@@ -51,6 +51,9 @@ class Euclidean(Manifold):
     def _log(self, p, x):
         return x - p
 
+    def _velocity(self, p, x):
+        return x - p
+
     def _dist(self, p, x):
         return safe_norm(x - p)
 

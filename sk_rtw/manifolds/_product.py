@@ -74,6 +74,18 @@ class Product(Manifold):
         )  # fmt: skip
 
     @property
+    def velocity_dim(self) -> int:
+        return sum(f.velocity_dim for f in self.factors)
+
+    def _velocity(self, p, x):
+        p, x = torch.broadcast_tensors(p, x)
+        return torch.cat(
+            [f._velocity(a, b)
+             for f, a, b in zip(self.factors, self._split(p), self._split(x), strict=True)],
+            dim=-1,
+        )  # fmt: skip
+
+    @property
     def distance_segments(self):
         segments, offset = [], 0
         for factor, size in zip(self.factors, self._sizes, strict=True):

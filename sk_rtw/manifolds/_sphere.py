@@ -206,6 +206,17 @@ class Sphere(Manifold):
     def intrinsic_dim(self) -> int:
         return self.dim
 
+    @property
+    def velocity_dim(self) -> int:
+        return 1 if self.dim == 1 else self.dim + 1
+
+    def _velocity(self, p, x):
+        v = self._log(p, x)
+        if self.dim > 1:  # the ambient vector: S^2 has no continuous frame
+            return v
+        # S^1: the component along the circle's own direction J p = (-p_1, p_0)
+        return (p[..., :1] * v[..., 1:] - p[..., 1:] * v[..., :1]).expand(*v.shape[:-1], 1)
+
     def _to_coordinates(self, p, v):
         return _sphere_to_coordinates(*torch.broadcast_tensors(p, v))
 
@@ -288,3 +299,15 @@ class Quaternion(Sphere):
 
     def _dist(self, p, x):
         return _sphere_dist(p, x, sign_invariant=True)
+
+    @property
+    def velocity_dim(self) -> int:
+        return 3
+
+    def _velocity(self, p, x):
+        # log_p(x) (x's representative in p's hemisphere) moved to the identity by p^-1:
+        # the vector part of conj(p) * v; twice it is the rotation vector of p^-1 x
+        v = self._log(p, x)
+        w, a = p[..., :1], p[..., 1:]
+        v0, b = v[..., :1], v[..., 1:]
+        return 2.0 * (w * b - v0 * a - torch.linalg.cross(a.expand_as(b), b, dim=-1))
