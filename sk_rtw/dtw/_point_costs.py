@@ -228,3 +228,36 @@ def segment_cost_stack(x, Y, nx, nys, segments, squared):
         segment_cost_matrix(x, Y[k], nx, nys[k], segments, squared, out[k])
     return out
 
+
+
+@njit(cache=True, nogil=True)
+def diagonal_cost(x, y, segments, squared):
+    """The cost of the direct, diagonal alignment of flattened series ``x`` and ``y``.
+
+    Equal lengths pair sample ``t`` with sample ``t``; unequal lengths step along the
+    longer series and pair its sample ``t`` with sample ``floor(t n / m)`` of the shorter
+    (``n`` samples, ``m`` the longer length): a warping path of ``m`` steps, ``m - n`` of
+    them off the diagonal, whose cost bounds the DTW distance from above (the costs
+    summed in the recursion's order: along the diagonal of equal lengths, its value bit
+    for bit). Amerced DTW scales its penalty by this cost (Herrmann and Webb, 2023).
+    """
+    nx, ny = x.shape[0], y.shape[0]
+    steps = max(nx, ny)
+    cost = np.empty(1)
+    total = 0.0
+    for t in range(steps):
+        j = t * ny // steps
+        _cost_row(x, y[j : j + 1], t * nx // steps, 1, segments, squared, cost)
+        total = cost[0] + total
+    return total
+
+
+@njit(cache=True, nogil=True)
+def diagonal_costs(X, lengths, first, second, segments, squared):
+    """:func:`diagonal_cost` of series ``first[k]`` and ``second[k]`` of ``X`` (``(n, L,
+    p)``, kernel form), for every ``k``."""
+    out = np.empty(first.shape[0])
+    for k in range(first.shape[0]):
+        a, b = first[k], second[k]
+        out[k] = diagonal_cost(X[a, : lengths[a]], X[b, : lengths[b]], segments, squared)
+    return out

@@ -24,7 +24,13 @@ every pair; :func:`nearest_by_class` computes the same values with far fewer cel
    over all classes is the threshold, and far classes are never searched to their end.
 3. **Early abandoning**: the DTW of a visited reference is computed with that threshold
    as a bound (:func:`~sk_rtw.dtw._pruned.pruned_distance`, PrunedDTW): cells that
-   cannot beat it are skipped, and the pair stops as soon as no path can.
+   cannot beat it are skipped, and the pair stops as soon as no path can. Where the
+   diagonal path lies in the band (equal lengths, or no band), its cost
+   (:func:`~sk_rtw.dtw._point_costs.diagonal_cost`, plus amerced DTW's penalty for the
+   steps off the diagonal of unequal lengths) bounds the pair's distance from above and
+   becomes the bound when it is lower: the first reference of a query is pruned too
+   (measured on the proximity forest's searches: 10-25 % less time on ArrowHead and
+   Lightning7, the same on GunPoint and ECG200).
 
 The distances returned are those of the exhaustive search bit for bit: a reference that
 is skipped cannot be nearer than the best so far (nor tie with it), and a distance that
@@ -220,8 +226,17 @@ def _nearest_by_class(
             threshold = min(best[c], limits[q]) if every_class else nearest
             if bound > threshold:
                 continue
-            value = _pruned.pruned_distance(x, R[r, : lr[r]], segments, squared, window,
-                                             threshold, penalty)  # fmt: skip
+            y = R[r, : lr[r]]
+            cut = threshold
+            if (window < 0.0 or window >= 1.0 or x.shape[0] == y.shape[0]) and cut > 0.0:
+                # the diagonal path lies in the band: its cost bounds this pair's distance
+                upper = _point_costs.diagonal_cost(x, y, segments, squared)
+                upper += penalty * abs(x.shape[0] - y.shape[0])
+                cut = min(cut, upper * (1.0 + LB_SLACK))
+            value = _pruned.pruned_distance(x, y, segments, squared, window, cut, penalty)
+            if value > cut and cut < threshold:  # rounding beat the slack: bound it again
+                value = _pruned.pruned_distance(x, y, segments, squared, window, threshold,
+                                                penalty)  # fmt: skip
             computed[q] += 1
             if value <= threshold and value < best[c]:
                 best[c] = value
