@@ -140,7 +140,31 @@ def test_other_manifolds_and_few_pairs_keep_the_one_pair_kernel(monkeypatch, rng
     assert not _lanes.lanes_apply(np.array([[0, 100, 0]]), many, 60_000)
     # the pairs counted are those computed: a symmetric matrix of 12 series has 66
     calls = []
-    monkeypatch.setattr(_dtw, "_in_lanes", lambda *a: calls.append(a) or np.zeros((12, 12)))
+    monkeypatch.setattr(_lanes, "lane_distances",
+                        lambda *a: calls.append(a) or np.zeros((12, 12)))  # fmt: skip
     dtw_pairwise_distance(series(rng, 12, [20], 1))
     dtw_pairwise_distance(series(rng, 11, [20], 1))  # 55 pairs
     assert len(calls) == 1
+
+
+@pytest.mark.parametrize("dim", [1, 3])
+@pytest.mark.parametrize("window", [None, 0.1])
+def test_amerced_lanes_equal_the_one_pair_kernel(dim, window, rng, lane_calls):
+    """With a penalty too, bit for bit."""
+    X, Y = series(rng, 5, [30], dim), series(rng, 41, [30, 31], dim)
+    manifold = Euclidean(dim)
+    cx, cy = check_series_collection(X, manifold), check_series_collection(Y, manifold)
+    w = _dtw.check_window(window)
+    flat_x, flat_y = _point_costs.kernel_series(cx), _point_costs.kernel_series(cy)
+    segments = _point_costs.segment_codes(manifold)
+    one_pair = _pruned.pairwise_segments(
+        flat_x, cx.lengths, flat_y, cy.lengths, segments, False, w, False,
+        np.full((5, 41), np.inf), 0.7,
+    )  # fmt: skip
+    got = _lanes.lane_distances(flat_x, cx.lengths, flat_y, cy.lengths, segments, False, w,
+                                False, 0.7)  # fmt: skip
+    assert np.array_equal(got, one_pair)
+    assert lane_calls["blocks"] > 0
+    assert np.array_equal(
+        dtw_pairwise_distance(X, Y, manifold, window=window, warp_penalty=0.7), one_pair
+    )

@@ -278,28 +278,6 @@ def dtw_pairwise_distance(
         return _pairwise(cx, cy, w, squared, symmetric, normalize == "path", penalty)
 
 
-def _in_lanes(flat_x, lx, flat_y, ly, segments, squared, window, symmetric) -> np.ndarray:
-    """:func:`~._pruned.pairwise_segments` without bounds, references of a common length
-    in the lanes of :mod:`._lanes` (the same values bit for bit), the others one pair at a
-    time."""
-    lx, ly = np.asarray(lx, dtype=np.int64), np.asarray(ly, dtype=np.int64)
-    values = np.zeros((flat_x.shape[0], flat_y.shape[0]))
-    (wide, narrow), single = _lanes.lane_blocks(ly)
-    for kernel, blocks in ((_lanes.pairwise_wide, wide), (_lanes.pairwise_narrow, narrow)):
-        if len(blocks):
-            kernel(flat_x, lx, flat_y, ly, segments, squared, window, blocks, symmetric, values)
-    if len(single):
-        rows, columns = np.meshgrid(np.arange(flat_x.shape[0]), single, indexing="ij")
-        if symmetric:  # the upper triangle, as the one-pair kernel orients it
-            upper = rows < columns
-            rows, columns = rows[upper], columns[upper]
-        _lanes.listed_pairs(flat_x, lx, flat_y, ly, segments, squared, window, rows.ravel(),
-                            columns.ravel(), values)  # fmt: skip
-    if symmetric:
-        values = np.triu(values, 1) + np.triu(values, 1).T
-    return values
-
-
 def _pairwise(
     cx: SeriesCollection, cy: SeriesCollection, window, squared, symmetric, per_step,
     penalty=0.0,
@@ -312,21 +290,19 @@ def _pairwise(
     if segments is not None:
         flat_x = _point_costs.kernel_series(cx)
         flat_y = _point_costs.kernel_series(cy)
-        if not per_step and penalty > 0:
-            return _pruned.pairwise_segments(
-                flat_x, cx.lengths, flat_y, cy.lengths, segments, squared, window, symmetric,
-                np.full((cx.n_series, cy.n_series), np.inf), penalty,
-            )  # fmt: skip
         if not per_step:
-            bounds = _guide_bounds(cx, cy, window, squared, symmetric)
+            if penalty == 0:
+                bounds = _guide_bounds(cx, cy, window, squared, symmetric)
+            else:  # a guide path's cost bounds DTW, not amerced DTW
+                bounds = np.full((cx.n_series, cy.n_series), np.inf)
             n_pairs = cx.n_series * (cx.n_series - 1) // 2 if symmetric else bounds.size
             fits = _lanes.lanes_apply(segments, n_pairs, cy.max_length)
             if fits and np.isinf(bounds).all():
-                return _in_lanes(flat_x, cx.lengths, flat_y, cy.lengths, segments, squared,
-                                 window, symmetric)  # fmt: skip
+                return _lanes.lane_distances(flat_x, cx.lengths, flat_y, cy.lengths, segments,
+                                             squared, window, symmetric, penalty)  # fmt: skip
             return _pruned.pairwise_segments(
                 flat_x, cx.lengths, flat_y, cy.lengths, segments, squared, window, symmetric,
-                bounds, 0.0,
+                bounds, penalty,
             )  # fmt: skip
     # Cost matrices for a block of pairs at a time (numba for the known point distances,
     # the vectorised geometry otherwise), then the parallel recursion over the block.

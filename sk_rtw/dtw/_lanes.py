@@ -117,6 +117,19 @@ def _step(prev, left, c, lane, cost):
 
 
 @njit(cache=True, nogil=True, inline="always")
+def _amerced_step(prev, left, c, lane, cost, penalty):
+    """:func:`~._kernels._amerced_cell` in one lane: the same comparisons, the same sums."""
+    best = prev[c, lane]
+    up = prev[c + 1, lane] + penalty
+    if up < best:
+        best = up
+    step = left[lane] + penalty
+    if step < best:
+        best = step
+    return cost + best
+
+
+@njit(cache=True, nogil=True, inline="always")
 def _segment_costs(xr, yb, Y, c, refs, first, segments, squared, cost, lanes):
     """Point costs of ``xr`` to column ``c`` of every lane, as :func:`_cost_row` computes
     them for Euclidean segments (the same sums in the same order, the same fallback)."""
@@ -143,8 +156,10 @@ def _segment_costs(xr, yb, Y, c, refs, first, segments, squared, cost, lanes):
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _block(X, lx, Y, ly, segments, squared, window, i, refs, symmetric, out, lanes):
-    """The distances of query ``i`` to the references of one block into ``out[i]``."""
+def _block(X, lx, Y, ly, segments, squared, window, i, refs, symmetric, out, lanes, penalty):
+    """The distances of query ``i`` to the references of one block into ``out[i]``
+    (amerced by ``penalty``; the plain cell where it is 0: every loop over the lanes is
+    written twice, as a test inside them would stop their vectorisation)."""
     first = refs[0]
     if symmetric:  # indices increase along a block: skip one below the diagonal
         last = first
@@ -174,7 +189,7 @@ def _block(X, lx, Y, ly, segments, squared, window, i, refs, symmetric, out, lan
         for lane in range(lanes):
             cur[lo[r], lane] = _INF
             left[lane] = _INF
-        if univariate:  # as _cost_row: |a - b| exactly, at any magnitude
+        if univariate and penalty == 0.0:  # as _cost_row: |a - b| exactly, at any magnitude
             a = x[r, 0]
             for c in range(lo[r], hi[r]):
                 for lane in range(lanes):
@@ -182,11 +197,25 @@ def _block(X, lx, Y, ly, segments, squared, window, i, refs, symmetric, out, lan
                     point = diff * diff if squared else diff
                     left[lane] = _step(prev, left, c, lane, point)
                     cur[c + 1, lane] = left[lane]
-        else:
+        elif univariate:
+            a = x[r, 0]
+            for c in range(lo[r], hi[r]):
+                for lane in range(lanes):
+                    diff = abs(a - flat[c, lane])
+                    point = diff * diff if squared else diff
+                    left[lane] = _amerced_step(prev, left, c, lane, point, penalty)
+                    cur[c + 1, lane] = left[lane]
+        elif penalty == 0.0:
             for c in range(lo[r], hi[r]):
                 _segment_costs(x[r], yb, Y, c, refs, first, segments, squared, cost, lanes)
                 for lane in range(lanes):
                     left[lane] = _step(prev, left, c, lane, cost[lane])
+                    cur[c + 1, lane] = left[lane]
+        else:
+            for c in range(lo[r], hi[r]):
+                _segment_costs(x[r], yb, Y, c, refs, first, segments, squared, cost, lanes)
+                for lane in range(lanes):
+                    left[lane] = _amerced_step(prev, left, c, lane, cost[lane], penalty)
                     cur[c + 1, lane] = left[lane]
         prev, cur = cur, prev
     for lane in range(lanes):
@@ -197,32 +226,60 @@ def _block(X, lx, Y, ly, segments, squared, window, i, refs, symmetric, out, lan
 
 # Two entry points on purpose: the number of lanes must be a compile-time constant for
 # the lane loops to vectorise (passed at run time, the wide kernel ran 1.7x slower).
-@njit(cache=True, nogil=True, parallel=True)
-def pairwise_wide(X, lx, Y, ly, segments, squared, window, blocks, symmetric, out):
+def _pairwise_wide(X, lx, Y, ly, segments, squared, window, blocks, symmetric, out, penalty):
     """Every query of ``X`` against every block of ``blocks`` (``WIDE`` lanes) into
-    ``out``; with ``symmetric`` (``Y`` is ``X``) only the pairs ``j > i``."""
+    ``out``; with ``symmetric`` (``Y`` is ``X``) only the pairs ``j > i``; ``penalty``:
+    amerced DTW's."""
     n_blocks = blocks.shape[0]
     for task in prange(X.shape[0] * n_blocks):
         i = task // n_blocks
         _block(X, lx, Y, ly, segments, squared, window, i, blocks[task - i * n_blocks],
-               symmetric, out, WIDE)  # fmt: skip
+               symmetric, out, WIDE, penalty)  # fmt: skip
 
 
-@njit(cache=True, nogil=True, parallel=True)
-def pairwise_narrow(X, lx, Y, ly, segments, squared, window, blocks, symmetric, out):
+def _pairwise_narrow(X, lx, Y, ly, segments, squared, window, blocks, symmetric, out, penalty):
     """:func:`pairwise_wide` for blocks of ``NARROW`` lanes."""
     n_blocks = blocks.shape[0]
     for task in prange(X.shape[0] * n_blocks):
         i = task // n_blocks
         _block(X, lx, Y, ly, segments, squared, window, i, blocks[task - i * n_blocks],
-               symmetric, out, NARROW)  # fmt: skip
+               symmetric, out, NARROW, penalty)  # fmt: skip
 
 
-@njit(cache=True, nogil=True, parallel=True)
-def listed_pairs(X, lx, Y, ly, segments, squared, window, rows, columns, out):
+def _listed_pairs(X, lx, Y, ly, segments, squared, window, rows, columns, out, penalty):
     """The pairs ``(rows[k], columns[k])`` one at a time (the one-pair kernel's plain
     recursion), into ``out``: the references no block holds."""
     for k in prange(rows.shape[0]):
         i, j = rows[k], columns[k]
         out[i, j] = pruned_distance(X[i, : lx[i]], Y[j, : ly[j]], segments, squared, window,
-                                    _INF)  # fmt: skip
+                                    _INF, penalty)  # fmt: skip
+
+
+pairwise_wide = njit(cache=True, nogil=True, parallel=True)(_pairwise_wide)
+pairwise_narrow = njit(cache=True, nogil=True, parallel=True)(_pairwise_narrow)
+listed_pairs = njit(cache=True, nogil=True, parallel=True)(_listed_pairs)
+
+
+def lane_distances(flat_x, lx, flat_y, ly, segments, squared, window, symmetric,
+                   penalty) -> np.ndarray:  # fmt: skip
+    """DTW (amerced by ``penalty``) of every series of ``flat_x`` against every series
+    of ``flat_y`` (kernel form): the references of a common length in lanes, the others
+    one pair at a time; with ``symmetric`` (``flat_y`` is ``flat_x``) the upper triangle,
+    mirrored. The values of the one-pair kernels, bit for bit."""
+    lx, ly = np.asarray(lx, dtype=np.int64), np.asarray(ly, dtype=np.int64)
+    values = np.zeros((flat_x.shape[0], flat_y.shape[0]))
+    (wide, narrow), single = lane_blocks(ly)
+    for kernel, blocks in ((pairwise_wide, wide), (pairwise_narrow, narrow)):
+        if len(blocks):
+            kernel(flat_x, lx, flat_y, ly, segments, squared, window, blocks, symmetric, values,
+                   penalty)  # fmt: skip
+    if len(single):
+        rows, columns = np.meshgrid(np.arange(flat_x.shape[0]), single, indexing="ij")
+        if symmetric:  # the upper triangle, as the one-pair kernel orients it
+            upper = rows < columns
+            rows, columns = rows[upper], columns[upper]
+        listed_pairs(flat_x, lx, flat_y, ly, segments, squared, window, rows.ravel(),
+                     columns.ravel(), values, penalty)  # fmt: skip
+    if symmetric:
+        values = np.triu(values, 1) + np.triu(values, 1).T
+    return values
