@@ -11,14 +11,16 @@ coarse-to-fine banded path for long series, exact below the size
 :func:`solved_exactly` tells), :func:`coarse_collection` (series halved by geodesic
 midpoints) and :func:`soft_dtw_batch` (soft-DTW values and expected alignments).
 :func:`dtw_nearest_distance` finds the nearest series of every group with lower bounds
-and early abandoning.
+and early abandoning; :func:`prepare_series` puts a collection in the kernels' form once
+for many searches on the calling thread (:func:`nearest_group`, and
+:func:`mean_diagonal_cost`, the scale of amerced DTW's penalty).
 
 The modules stand on floors, each importing only those below it: the compiled point
 costs (``_spd_kernels``, ``_point_costs``); the compiled recursion (``_kernels``, and
 ``_pruned`` with the point costs inside it; ``_soft``); point-cost matrices and the
 optimal path through them (``_costs``); the coarse-to-fine band (``_band``); paths
 between series (``_paths``); the distances (``_dtw``); their consumers (``_medoid``,
-``_search``).
+``_search``); prepared series for many searches (``_prepared``).
 """
 
 from ._band import coarse_collection, multiscale_path, solved_exactly
@@ -26,10 +28,12 @@ from ._costs import optimal_path, point_cost_matrix
 from ._dtw import check_window, dtw_cost_matrix, dtw_distance, dtw_pairwise_distance, dtw_path
 from ._medoid import medoid_index
 from ._paths import has_compiled_costs, mean_matched_positions, path_indices
+from ._prepared import PreparedSeries, mean_diagonal_cost, nearest_group, prepare_series
 from ._search import dtw_nearest_distance
 from ._soft import soft_dtw_batch
 
 __all__ = [
+    "PreparedSeries",
     "check_window",
     "coarse_collection",
     "dtw_cost_matrix",
@@ -38,12 +42,15 @@ __all__ = [
     "dtw_pairwise_distance",
     "dtw_path",
     "has_compiled_costs",
+    "mean_diagonal_cost",
     "mean_matched_positions",
     "medoid_index",
     "multiscale_path",
+    "nearest_group",
     "optimal_path",
     "path_indices",
     "point_cost_matrix",
+    "prepare_series",
     "soft_dtw_batch",
     "solved_exactly",
 ]
