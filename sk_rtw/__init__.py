@@ -19,6 +19,7 @@ from .estimators import (
     RTWKMeans,
     RTWNearestCentroid,
     RTWPrototypeClassifier,
+    RTWProximityForest,
     TTWAverager,
     TTWNearestCentroid,
 )
@@ -58,6 +59,7 @@ __all__ = [
     "RTWKMeans",
     "RTWNearestCentroid",
     "RTWPrototypeClassifier",
+    "RTWProximityForest",
     "Sphere",
     "TTWAverager",
     "TTWNearestCentroid",

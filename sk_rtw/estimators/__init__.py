@@ -1,8 +1,9 @@
 """scikit-learn estimators: class means by time warping, nearest-centroid and prototype
-classifiers."""
+classifiers, and a proximity forest."""
 
 from ._averager import NTWAverager, RTWAverager, TTWAverager
 from ._classifier import NTWNearestCentroid, RTWNearestCentroid, TTWNearestCentroid
+from ._forest import RTWProximityForest
 from ._kmeans import RTWKMeans
 from ._prototypes import RTWPrototypeClassifier
 
@@ -13,6 +14,7 @@ __all__ = [
     "RTWKMeans",
     "RTWNearestCentroid",
     "RTWPrototypeClassifier",
+    "RTWProximityForest",
     "TTWAverager",
     "TTWNearestCentroid",
 ]

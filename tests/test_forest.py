@@ -1,0 +1,304 @@
+"""RTWProximityForest: scikit-learn conformance, determinism across threads, its splits
+against brute force, manifold-valued and unequal-length series, clear errors."""
+
+from __future__ import annotations
+
+import pickle
+
+import numpy as np
+import pytest
+from sklearn.base import clone
+from sklearn.model_selection import GridSearchCV
+from sklearn.pipeline import Pipeline
+from sklearn.preprocessing import FunctionTransformer
+from sklearn.utils.estimator_checks import parametrize_with_checks
+
+from sk_rtw import RTWProximityForest, dtw_distance, tangent_velocity
+from sk_rtw.dtw import mean_diagonal_cost, nearest_group, prepare_series
+from sk_rtw.estimators._proximity_split import (
+    Measure,
+    NodeSeries,
+    best_split,
+    gini,
+    gini_gain,
+)
+from sk_rtw.manifolds import SPD, Product, Quaternion, Sphere
+from sk_rtw.representations import represent
+from sk_rtw.utils import check_series_collection
+
+from .test_dtw import random_walk
+from .test_estimators import EXPECTED_FAILURES, two_shape_classes, znorm
+
+
+def _expected_failures(estimator):
+    return EXPECTED_FAILURES
+
+
+@parametrize_with_checks(
+    [RTWProximityForest(n_trees=3, random_state=0)], expected_failed_checks=_expected_failures
+)
+def test_sklearn_compatible(estimator, check):
+    check(estimator)
+
+
+def three_classes(n_per_class=8, length=30, seed=0):
+    """Univariate three-class data: warped sine, bump and ramp shapes with noise."""
+    rng = np.random.default_rng(seed)
+    t = np.linspace(0, 1, length)
+    shapes = (
+        lambda u: np.sin(2 * np.pi * u),
+        lambda u: np.exp(-((u - 0.5) ** 2) / 0.01),
+        lambda u: 2 * u - 1,
+    )
+    X, y = [], []
+    for label, shape in enumerate(shapes):
+        for _ in range(n_per_class):
+            X.append(shape(t ** np.exp(rng.normal(0, 0.3))) + 0.1 * rng.standard_normal(length))
+            y.append(f"c{label}")
+    return np.array(X), np.array(y)
+
+
+def test_the_same_seed_gives_the_same_forest_for_any_n_jobs():
+    X, y = three_classes()
+    one = RTWProximityForest(n_trees=12, random_state=3, n_jobs=1).fit(X, y)
+    two = RTWProximityForest(n_trees=12, random_state=3, n_jobs=2).fit(X, y)
+    test, _ = three_classes(seed=5)
+    np.testing.assert_array_equal(one.predict_proba(test), two.predict_proba(test))
+    for a, b in zip(one.trees_, two.trees_, strict=True):
+        assert a.n_nodes_ == b.n_nodes_ and a.root_.measure == b.root_.measure
+    other = RTWProximityForest(n_trees=12, random_state=4).fit(X, y)
+    assert [t.root_.measure for t in other.trees_] != [t.root_.measure for t in one.trees_]
+
+
+def test_training_series_reach_their_own_pure_leaves():
+    """Prediction retraces the splits of the fit: every training series reaches the leaf
+    it was grown into, and every leaf is pure, so each tree classifies the training set
+    perfectly."""
+    X, y = three_classes()
+    forest = RTWProximityForest(n_trees=5, random_state=0).fit(X, y)
+    codes = np.searchsorted(forest.classes_, y)
+    for tree in forest.trees_:
+        proba = tree.predict_proba(forest._prepared(X), forest._train)
+        np.testing.assert_array_equal(proba, np.eye(3)[codes])
+    assert forest.score(X, y) == 1.0
+
+
+def test_predict_proba_is_the_mean_of_the_trees_leaves():
+    X, y = three_classes()
+    test, test_y = three_classes(seed=9)
+    forest = RTWProximityForest(n_trees=7, random_state=1).fit(X, y)
+    data = forest._prepared(test)
+    votes = np.mean([tree.predict_proba(data, forest._train) for tree in forest.trees_], 0)
+    np.testing.assert_allclose(forest.predict_proba(test), votes, atol=1e-15)
+    np.testing.assert_allclose(forest.predict_proba(test).sum(1), 1.0)
+    assert np.array_equal(forest.predict(test), forest.classes_[votes.argmax(1)])
+    assert forest.score(test, test_y) >= 0.9
+
+
+def _brute_force_branches(series, exemplars, measure, manifold):
+    def distance(s, e):
+        return dtw_distance(s, e, manifold, window=measure.window, squared=measure.squared,
+                            warp_penalty=measure.warp_penalty)  # fmt: skip
+
+    return np.array([[distance(s, e) for e in exemplars] for s in series]).argmin(1)
+
+
+@pytest.mark.parametrize("manifold", [Sphere(2), SPD(2), Product((Sphere(1), SPD(2)))], ids=repr)
+def test_every_candidate_sends_each_series_to_its_nearest_exemplar(manifold):
+    """The branches of the kept split are the brute-force argmin of the drawn measure's
+    distances (manifold DTW of the drawn representation), for every representation."""
+    X = np.stack([random_walk(manifold, 12, s, step=0.3) for s in range(14)])
+    codes = np.repeat([0, 1], 7)
+    collection = check_series_collection(X, manifold)
+    collections = {r: represent(collection, r) for r in ("raw", "velocity")}
+    data = {r: prepare_series(c) for r, c in collections.items()}
+    indices = np.arange(2, 14)
+    for seed in range(6):
+        node = NodeSeries(indices, codes[indices])
+        split, branches = best_split(
+            np.random.default_rng(seed), node, data, collections, 2, 3, ("raw", "velocity"),
+            "series",
+        )  # fmt: skip
+        measure = split.measure
+        space = collections[measure.representation]
+        expected = _brute_force_branches(
+            [space.series(i) for i in indices],
+            [space.series(i) for i in split.exemplars],
+            measure, space.manifold,
+        )  # fmt: skip
+        np.testing.assert_array_equal(branches, expected)
+        assert split.gain == pytest.approx(gini_gain(codes[indices], branches, 2, 2))
+        assert set(codes[split.exemplars]) == {0, 1}  # one exemplar of each class
+
+
+def test_gini_and_its_gain_by_hand():
+    codes = np.array([0, 0, 1, 1, 1, 2])
+    assert gini(codes, 3) == pytest.approx(1 - (4 + 9 + 1) / 36)
+    branches = np.array([0, 0, 1, 1, 1, 1])  # a pure branch and one of (1, 1, 1, 2)
+    children = (4 / 6) * (1 - (9 + 1) / 16)
+    assert gini_gain(codes, branches, 2, 3) == pytest.approx(gini(codes, 3) - children)
+    assert gini_gain(codes, np.zeros(6, dtype=int), 2, 3) == pytest.approx(0.0)
+
+
+def test_the_penalty_scale_is_the_mean_direct_alignment_cost(rng):
+    X = [rng.standard_normal(n) for n in (20, 20, 26)]
+    prepared = prepare_series(check_series_collection(X))
+    got = mean_diagonal_cost(prepared, np.array([0, 2]), np.array([1, 0]), squared=True)
+    t = np.arange(26)
+    unequal = ((X[2] - X[0][t * 20 // 26]) ** 2).sum()  # the longer series steps
+    assert got == pytest.approx((((X[0] - X[1]) ** 2).sum() + unequal) / 2, rel=1e-12)
+    # the same on a manifold without compiled costs (its own distance)
+    M = Product((Sphere(2), SPD(13)))
+    Y = [random_walk(M, n, s) for s, n in enumerate((5, 7))]
+    prepared = prepare_series(check_series_collection(Y, M))
+    assert prepared.segments is None
+    step = np.arange(7) * 5 // 7
+    assert mean_diagonal_cost(prepared, np.array([0]), np.array([1]), False) == pytest.approx(
+        float(M.dist(Y[0][step], Y[1]).sum()), rel=1e-12
+    )
+
+
+def test_nearest_group_on_a_manifold_without_compiled_costs_matches_the_kernels():
+    M = Product((Sphere(2), SPD(13)))
+    X = np.stack([random_walk(M, 6, s) for s in range(5)])
+    prepared = prepare_series(check_series_collection(X, M))
+    got = nearest_group(prepared.take([0, 1, 2]), prepared.take([3, 4]), np.array([0, 1]), 2,
+                        0.2, False, 0.1)  # fmt: skip
+    expected = _brute_force_branches(X[:3], X[3:], Measure("raw", 0.2, False, 0.1), M)
+    np.testing.assert_array_equal(got, expected)
+
+
+@pytest.mark.parametrize(
+    ("manifold", "step"), [(Quaternion(), 0.2), (SPD(2), 0.3), (Sphere(2), 0.2)], ids=repr
+)
+def test_manifold_valued_and_unequal_length_series(manifold, step):
+    """Two classes of random walks whose steps differ in size: the velocity tells them
+    apart; lists of unequal lengths are accepted at fit and prediction."""
+    rng = np.random.default_rng(0)
+    X = [random_walk(manifold, int(rng.integers(15, 25)), s, step=step * (1 + (s % 2)))
+         for s in range(16)]  # fmt: skip
+    y = np.arange(16) % 2
+    forest = RTWProximityForest(manifold, n_trees=10, random_state=0).fit(X[:12], y[:12])
+    assert forest.manifold_ == manifold
+    assert forest.predict_proba(X[12:]).shape == (4, 2)
+    assert forest.score(X[:12], y[:12]) == 1.0
+
+
+def test_multivariate_euclidean_series_and_the_velocity_alone():
+    X, y = three_classes()
+    X3 = np.stack([X, X**2, -X], axis=-1)
+    forest = RTWProximityForest(n_trees=5, representation="velocity", random_state=0)
+    forest.fit(X3, y)
+    assert forest.representations_ == ("velocity",)
+    assert {t.root_.measure.representation for t in forest.trees_} == {"velocity"}
+    raw = RTWProximityForest(n_trees=5, representation="raw", random_state=0).fit(X3, y)
+    assert {t.root_.measure.representation for t in raw.trees_} == {"raw"}
+
+
+def test_a_tree_reads_its_exemplars_from_the_training_set():
+    X, y = three_classes()
+    forest = RTWProximityForest(n_trees=3, random_state=2).fit(X, y)
+    root = forest.trees_[0].root_
+    classes = forest.classes_[root.split.classes]
+    assert list(y[root.split.exemplars]) == list(classes)
+    assert len(root.children) == len(classes) == 3
+    assert str(root.measure).startswith(("DTW", "ADTW"))
+
+
+def test_mean_exemplars_are_averages_with_randomness_of_their_own():
+    X, y = three_classes(n_per_class=9)
+    forest = RTWProximityForest(n_trees=4, exemplars="mean", random_state=0).fit(X, y)
+    root = forest.trees_[0].root_
+    assert (root.split.exemplars == -1).all()  # 9 series per class: subsets of 3 averaged
+    assert root.split.means.n_series == 3
+    again = RTWProximityForest(n_trees=4, exemplars="mean", random_state=0).fit(X, y)
+    np.testing.assert_array_equal(forest.predict_proba(X), again.predict_proba(X))
+    assert forest.score(X, y) == 1.0
+
+
+def test_max_depth_stops_the_trees():
+    X, y = three_classes()
+    forest = RTWProximityForest(n_trees=4, max_depth=1, random_state=0).fit(X, y)
+    assert max(tree.depth_ for tree in forest.trees_) == 1
+    assert np.allclose(forest.predict_proba(X).sum(1), 1.0)
+
+
+def test_series_no_measure_tells_apart_make_a_leaf():
+    """Identical series of two classes: every exemplar ties with the other class's, so
+    the node cannot be split and keeps both classes' proportions."""
+    X = np.tile(np.linspace(0, 1, 10), (6, 1))
+    y = [0, 1, 0, 1, 0, 1]
+    forest = RTWProximityForest(n_trees=3, random_state=0).fit(X, y)
+    assert all(tree.n_nodes_ == 1 for tree in forest.trees_)
+    np.testing.assert_allclose(forest.predict_proba(X[:2]), 0.5)
+
+
+def test_pipeline_gridsearch_clone_pickle():
+    X, y = two_shape_classes()
+    pipe = Pipeline([("scale", FunctionTransformer(znorm)),
+                     ("forest", RTWProximityForest(n_trees=5, random_state=0))])  # fmt: skip
+    assert pipe.fit(X, y).score(X, y) == 1.0
+    grid = GridSearchCV(RTWProximityForest(n_trees=3, random_state=0),
+                        {"representation": ["raw", "velocity"], "n_candidates": [1, 3]}, cv=2)
+    grid.fit(X, y)  # fmt: skip
+    assert grid.best_params_["representation"] in ("raw", "velocity")
+    forest = RTWProximityForest(n_trees=4, random_state=0).fit(X, y)
+    clone(forest)
+    restored = pickle.loads(pickle.dumps(forest))
+    np.testing.assert_array_equal(restored.predict_proba(X), forest.predict_proba(X))
+
+
+def test_random_states_of_every_accepted_type():
+    X, y = three_classes(n_per_class=4)
+    for state in (np.random.RandomState(0), np.random.default_rng(0), None, 7):
+        RTWProximityForest(n_trees=2, random_state=state).fit(X, y)
+
+
+def test_verbose_reports_every_tree(capsys):
+    X, y = three_classes(n_per_class=4)
+    RTWProximityForest(n_trees=3, verbose=1, random_state=0).fit(X, y)
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 3 and "tree 3/3" in lines[-1] and "nodes" in lines[-1]
+
+
+@pytest.mark.parametrize(
+    ("params", "match"),
+    [
+        ({"n_trees": 0}, "n_trees"),
+        ({"n_candidates": 1.5}, "n_candidates"),
+        ({"representation": "derivative"}, "representation"),
+        ({"exemplars": "medoid"}, "exemplars"),
+        ({"max_depth": 0}, "max_depth"),
+        ({"n_jobs": 0}, "n_jobs"),
+        ({"random_state": "a"}, "random_state"),
+    ],
+)
+def test_bad_parameters_are_named(params, match):
+    X, y = three_classes(n_per_class=3)
+    with pytest.raises((ValueError, TypeError), match=match):
+        RTWProximityForest(**params).fit(X, y)
+
+
+def test_bad_data_get_clear_errors():
+    X, y = three_classes(n_per_class=3)
+    with pytest.raises(ValueError, match="2 classes"):
+        RTWProximityForest().fit(X, ["a"] * len(X))
+    with pytest.raises(ValueError, match="time points"):
+        RTWProximityForest().fit([np.arange(5.0), np.array([1.0])], [0, 1])
+    RTWProximityForest(n_trees=2, representation="raw").fit(
+        [np.arange(5.0), np.array([1.0])], [0, 1]
+    )  # one sample is a series when only the raw series are compared
+    with pytest.raises(ValueError, match="NaN"):
+        RTWProximityForest().fit(np.where(X > 0.5, np.nan, X), y)
+    with pytest.raises(ValueError, match="not a point"):
+        RTWProximityForest("sphere").fit(np.ones((4, 6, 3)), [0, 1, 0, 1])
+    forest = RTWProximityForest(n_trees=2, random_state=0).fit(X, y)
+    with pytest.raises(ValueError, match=r"expected|shape"):
+        forest.predict(np.ones((2, 5, 3)))
+
+
+def test_the_velocity_representation_is_the_tangent_velocity():
+    X, _ = three_classes(n_per_class=2)
+    collection = check_series_collection(X)
+    np.testing.assert_array_equal(represent(collection, "velocity").data[..., 0],
+                                  tangent_velocity(X))  # fmt: skip
