@@ -14,7 +14,10 @@ For one dataset and each method:
    per class chosen from the training data, every centroid averaged with the method);
    ``rtw-prototype`` and ``dba-prototype`` are :class:`sk_rtw.RTWPrototypeClassifier`
    with that method (the default classifier's centroids, out-of-fold distances to every
-   centroid and a linear readout); ``aeon-dba`` is aeon's ``elastic_barycenter_average``
+   centroid and a linear readout); ``rtw-forest`` is :class:`sk_rtw.RTWProximityForest`
+   (no averaging: a forest of proximity trees on the series and their tangent velocity),
+   ``rtw-forest-raw`` the same without the velocity, ``rtw-forest-mean`` with DBA means of
+   random class subsets as exemplars; ``aeon-dba`` is aeon's ``elastic_barycenter_average``
    with DTW (a reference where the data are Euclidean); ``minirocket`` is aeon's
    ``MiniRocketClassifier`` (the field's default classifier; unequal-length series are
    linearly resampled to the longest training length first, which it needs);
@@ -61,6 +64,7 @@ from sk_rtw import (
     Alignment,
     RTWNearestCentroid,
     RTWPrototypeClassifier,
+    RTWProximityForest,
     dtw_nearest_distance,
     dtw_pairwise_distance,
 )
@@ -99,6 +103,13 @@ ESTIMATOR_METHODS: dict[str, tuple[str, dict, str, dict]] = {
     "rtw-prototype": ("rtw", {}, "class-means", {}),
     "dba-prototype": ("dba", {}, "class-means", {}),
 }
+#: Rows of RTWProximityForest: the default forest, and its measured alternatives (no
+#: tangent velocity; DBA means of random class subsets as exemplars).
+FOREST_METHODS: dict[str, dict] = {
+    "rtw-forest": {},
+    "rtw-forest-raw": {"representation": "raw"},
+    "rtw-forest-mean": {"exemplars": "mean"},
+}
 #: Rows of the classifier a user gets by default.
 DEFAULT_CLASSIFIERS = tuple(m for m in ESTIMATOR_METHODS if m.endswith("-default"))
 #: Rows of RTWPrototypeClassifier.
@@ -106,7 +117,7 @@ PROTOTYPE_CLASSIFIERS = tuple(m for m in ESTIMATOR_METHODS if m.endswith("-proto
 REFERENCE_METHODS = ("aeon-dba", "1nn-dtw", "1nn-dtw-band", "minirocket")
 #: Rows that do not depend on the seed: ``--resume`` keeps them when only the seed changed.
 SEED_FREE = ("1nn-dtw", "1nn-dtw-band")
-ALL_METHODS = (*ESTIMATOR_METHODS, *REFERENCE_METHODS)
+ALL_METHODS = (*ESTIMATOR_METHODS, *FOREST_METHODS, *REFERENCE_METHODS)
 #: The main job's rows: the paper's one-mean comparison, the default classifier, the
 #: prototype classifier and the references (``rtw-paper`` is slow: means of length N T
 #: with the network at every time point; the ablations and the other default and
@@ -247,6 +258,30 @@ def _fit_estimator(method, train, test, config):
         "iterations": [a.n_iter for a in estimator.alignments_],
         "output_length": [len(m) for m in estimator.means_],
         **extra,
+    }
+
+
+def _fit_forest(method, train, test, config):
+    """Fit one forest row (one thread); its predictions, probabilities and times."""
+    forest = RTWProximityForest(
+        random_state=config.seed, n_jobs=1, verbose=max(0, config.verbose - 1),
+        **FOREST_METHODS[method],
+    )  # fmt: skip
+    start = time.perf_counter()
+    forest.fit(train.X, train.y)
+    fit_seconds = time.perf_counter() - start
+    start = time.perf_counter()
+    probabilities = forest.predict_proba(test.X)  # predict is its argmax
+    predict_seconds = time.perf_counter() - start
+    return {
+        "fit_seconds": fit_seconds,
+        "predict_seconds": predict_seconds,
+        "predictions": forest.classes_[np.argmax(probabilities, axis=1)],
+        "probabilities": probabilities,
+        "classes": forest.classes_,
+        "parameters": repr(forest),
+        "n_nodes": [tree.n_nodes_ for tree in forest.trees_],
+        "depth": [tree.depth_ for tree in forest.trees_],
     }
 
 
@@ -432,6 +467,11 @@ def warm_up(methods) -> None:
         if method in ESTIMATOR_METHODS and method not in _WARM:
             make_estimator(method, RunConfig(epochs=2, verbose=0)).fit(X, y).predict(X)
             _WARM.add(method)
+        if method in FOREST_METHODS and method not in _WARM:
+            RTWProximityForest(n_trees=2, random_state=0, **FOREST_METHODS[method]).fit(
+                X, y
+            ).predict(X)
+            _WARM.add(method)
         if method == "minirocket" and method not in _WARM:  # numba compiles its kernels
             split = Split(X=X, y=np.asarray(y), lengths=np.full(len(X), X.shape[1]))
             _fit_minirocket(split, split, RunConfig(verbose=0))
@@ -515,6 +555,8 @@ def _process_dataset(name, config, position, on_method_done) -> dict:
             try:
                 if method in ESTIMATOR_METHODS:
                     out = _fit_estimator(method, train, test, config)
+                elif method in FOREST_METHODS:
+                    out = _fit_forest(method, train, test, config)
                 elif method == "aeon-dba":
                     out = _fit_aeon_dba(train, test, config)
                 elif method == "1nn-dtw":
