@@ -19,11 +19,13 @@ from aeon.testing.estimator_checking._yield_multithreading_checks import (
 from aeon.testing.testing_data import FULL_TEST_DATA_DICT
 
 from benchmarks.ucr._data import available_datasets, load_split
-from sk_rtw import DBA, RTW, RTWNearestCentroid
-from sk_rtw.aeon import RTWClassifier
+from sk_rtw import DBA, RTW, RTWNearestCentroid, RTWProximityForest
+from sk_rtw.aeon import RTWClassifier, RTWProximityForestClassifier
+from sk_rtw.manifolds import Quaternion
 from sk_rtw.utils import from_aeon, to_aeon
 
 from .conftest import UCR_DIR
+from .test_dtw import random_walk
 
 
 @parametrize_with_checks([RTWClassifier])
@@ -130,3 +132,45 @@ def test_same_predictions_on_the_development_archive():
         ours = RTWClassifier(**params).fit(to_aeon(train.X), train.y).predict(to_aeon(test.X))
         plain = RTWNearestCentroid(**params).fit(train.X, train.y).predict(test.X)
         np.testing.assert_array_equal(ours, plain, err_msg=name)
+
+
+# ------------------------------------------------------------- the forest
+@parametrize_with_checks([RTWProximityForestClassifier])
+def test_aeon_estimator_checks_of_the_forest(check):
+    check()
+
+
+def test_forest_signature_is_the_forests():
+    ours = inspect.signature(RTWProximityForestClassifier).parameters
+    theirs = inspect.signature(RTWProximityForest).parameters
+    assert list(ours) == list(theirs)
+    differing = {n for n in ours if ours[n].default != theirs[n].default}
+    assert differing == {"n_jobs"}
+
+
+@pytest.mark.parametrize("equal", [True, False])
+@pytest.mark.parametrize("channels", [1, 3])
+def test_same_predictions_and_probabilities_as_the_forest(channels, equal):
+    rng = np.random.default_rng(4)
+    lengths = [30] * 20 if equal else list(rng.integers(25, 40, 20))
+    X = _walks(rng, 20, channels, lengths)
+    X = [x + (i % 2) * np.linspace(0, 4, x.shape[1]) for i, x in enumerate(X)]
+    y = np.array(["up" if i % 2 else "flat" for i in range(20)])
+    if equal:
+        X = np.stack(X)
+    params = {"n_trees": 6, "random_state": 0}
+    aeon_clf = RTWProximityForestClassifier(**params).fit(X[:14], y[:14])
+    plain = RTWProximityForest(**params).fit(from_aeon(X[:14]), y[:14])
+    np.testing.assert_array_equal(
+        aeon_clf.predict_proba(X[14:]), plain.predict_proba(from_aeon(X[14:]))
+    )
+    np.testing.assert_array_equal(aeon_clf.predict(X[14:]), plain.predict(from_aeon(X[14:])))
+
+
+def test_forest_on_quaternion_channels():
+    walks = [random_walk(Quaternion(), 20, s, step=0.1 * (1 + s % 2)) for s in range(12)]
+    X = np.stack([w.T for w in walks])  # (n, 4 channels, T)
+    y = np.arange(12) % 2
+    forest = RTWProximityForestClassifier("quaternion", n_trees=5, random_state=0).fit(X, y)
+    assert forest.estimator_.manifold_ == Quaternion()
+    assert forest.predict(X).shape == (12,)

@@ -1,4 +1,6 @@
-"""aeon-native entry points: sk_rtw's classifiers as aeon estimators.
+"""aeon-native entry points: sk_rtw's classifiers as aeon estimators
+(:class:`RTWClassifier`, the nearest-centroid classifier; :class:`RTWProximityForestClassifier`,
+the proximity forest).
 
 For researchers who work in aeon (and tsml-eval): data as ``load_classification``
 returns them, ``(n_cases, n_channels, n_timepoints)`` or a list of ``(n_channels, T_i)``
@@ -16,5 +18,6 @@ except ImportError as exc:  # pragma: no cover - exercised without aeon only
     ) from exc
 
 from ._classifier import RTWClassifier
+from ._forest import RTWProximityForestClassifier
 
-__all__ = ["RTWClassifier"]
+__all__ = ["RTWClassifier", "RTWProximityForestClassifier"]
