@@ -65,6 +65,20 @@ def existing_directory(text: str) -> str:
     return text
 
 
+def published_file(text: str) -> Path:
+    """argparse type: a published-results CSV that exists and has a ``dataset`` column."""
+    path = Path(text)
+    if not path.is_file():
+        raise argparse.ArgumentTypeError(f"{text!r} is not an existing file")
+    with path.open(newline="") as handle:
+        header = handle.readline().strip().split(",")
+    if "dataset" not in header:
+        raise argparse.ArgumentTypeError(
+            f"{text!r} has no 'dataset' column: expected a published_results.csv"
+        )
+    return path
+
+
 def check_writable(path: str | Path, *, directory: bool = False) -> Path:
     """``path`` (a file, or a folder with ``directory=True``) can be written: its folder
     exists or can be made, and a file can be created there. Raises ``SystemExit`` with

@@ -75,6 +75,7 @@ from benchmarks._shared import (
     output_length,
     positive_float,
     positive_int,
+    published_file,
 )
 from benchmarks.ucr._cluster import connect
 from benchmarks.ucr._data import (
@@ -94,6 +95,7 @@ from benchmarks.ucr._protocol import (
     record_path,
     reusable,
 )
+from benchmarks.ucr._published import default_published, published_markdown, read_published
 from benchmarks.ucr._resamples import load_resample_records, resamples_markdown
 from benchmarks.ucr._summary import (
     FIXED_HALVES,
@@ -200,6 +202,14 @@ def parse_args(argv=None) -> argparse.Namespace:
     )
     parser.add_argument(
         "--out", default="results/ucr", help="results directory (default results/ucr)"
+    )
+    parser.add_argument(
+        "--published",
+        type=published_file,
+        default=None,
+        metavar="FILE",
+        help="published split-0 accuracies to print beside this run's (a "
+        "published_results.csv; default: the one in --data-dir, if any)",
     )
     parser.add_argument(
         "--halves",
@@ -379,6 +389,11 @@ def main(argv=None) -> int:
         + (" x resample" if args.resamples > 1 else "")
     )
     text = markdown(records, list(args.methods), command.strip(), machine, halves=args.halves)
+    published = args.published or default_published(args.data_dir)
+    if published is not None:
+        text += "\n" + "\n".join(
+            published_markdown(records, list(args.methods), read_published(published))
+        )
     every_resample = load_resample_records(out, names, args.resamples)
     if args.resamples > 1:
         text += "\n" + "\n".join(
