@@ -42,6 +42,12 @@ def velocity_collection(collection: SeriesCollection) -> SeriesCollection:
     )
 
 
+def represented_manifold(manifold: Manifold, representation: str) -> Manifold:
+    """The space of a representation's samples: the manifold itself, or
+    ``Euclidean(manifold.velocity_dim)`` for the velocity."""
+    return manifold if representation == "raw" else Euclidean(manifold.velocity_dim)
+
+
 def represent(collection: SeriesCollection, representation: str) -> SeriesCollection:
     """``collection`` in ``representation`` (one of :data:`REPRESENTATIONS`): the
     collection itself, or its :func:`velocity_collection`."""

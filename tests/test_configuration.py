@@ -29,12 +29,14 @@ ESTIMATORS = [
     and not issubclass(cls, AveragingMethod)
 ]  # fmt: skip
 DECLARED = [*ESTIMATORS, *METHODS.values()]
+#: The estimators that average (a method and a preset): the proximity forest does not.
+AVERAGING = [cls for cls in ESTIMATORS if "method" in cls._declaration.defaults]
 
 
 def test_every_public_estimator_and_method_is_checked():
     names = {cls.__name__ for cls in DECLARED}
     assert {"RTWAverager", "RTWNearestCentroid", "RTWKMeans", "TTWNearestCentroid",
-            "NTWAverager", "RTW", "TTW", "NTW", "DBA"} <= names  # fmt: skip
+            "NTWAverager", "RTWProximityForest", "RTW", "TTW", "NTW", "DBA"} <= names  # fmt: skip
 
 
 @pytest.mark.parametrize("cls", DECLARED, ids=lambda c: c.__name__)
@@ -152,7 +154,7 @@ def test_a_users_own_method_works_in_every_estimator_in_clone_and_in_a_search():
 
 
 # ------------------------------------------------------------------ help() says what runs
-@pytest.mark.parametrize("cls", ESTIMATORS, ids=lambda c: c.__name__)
+@pytest.mark.parametrize("cls", AVERAGING, ids=lambda c: c.__name__)
 def test_help_lists_the_default_methods_settings_under_every_preset(cls):
     defaults = cls._declaration.defaults
     method, first = defaults["method"], defaults["preset"]

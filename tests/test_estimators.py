@@ -442,3 +442,38 @@ def test_many_centroids_predict_as_the_exhaustive_search(manifold):
     np.testing.assert_array_equal(clf.class_distances(X_new), by_class)
     np.testing.assert_array_equal(clf.predict(X_new), clf.classes_[by_class.argmin(1)])
     np.testing.assert_allclose(clf.predict_proba(X_new).sum(1), 1.0)
+
+
+# ------------------------------------------------------------- representation
+@pytest.mark.parametrize("method", ["dba", "rtw"])
+def test_velocity_representation_is_the_classifier_on_the_tangent_velocity(method):
+    """representation="velocity" is the same classifier fitted on tangent_velocity(X)
+    (Euclidean): the same centroids and distances; inputs stay on the manifold."""
+    from sk_rtw import tangent_velocity
+
+    from .test_dtw import random_walk
+
+    walks = [random_walk(Quaternion(), 20, s, step=0.1 * (1 + s % 2)) for s in range(12)]
+    X, y = np.stack(walks), np.arange(12) % 2
+    settings = {"method": quick(method) if method == "rtw" else "dba", "random_state": 0,
+                "n_centroids": 1, "dtw_window": 0.2}  # fmt: skip
+    ours = RTWNearestCentroid("quaternion", representation="velocity", **settings).fit(X, y)
+    direct = RTWNearestCentroid("euclidean", **settings).fit(tangent_velocity(X, "quaternion"), y)
+    assert ours.manifold_ == Quaternion() and ours.representation_ == "velocity"
+    np.testing.assert_allclose(ours.means_, direct.means_, atol=1e-12)
+    np.testing.assert_allclose(ours.class_distances(X),
+                               direct.class_distances(tangent_velocity(X, "quaternion")),
+                               atol=1e-10)  # fmt: skip
+    assert ours.transform(X).shape == (12, 2)
+    with pytest.raises(ValueError, match="representation"):
+        RTWNearestCentroid(representation="derivative").fit(X[..., 0], y)
+    with pytest.raises(ValueError, match="time points"):
+        ours.predict([X[0, :1]])
+
+
+def test_prototype_classifier_passes_the_representation_on():
+    X, y = two_shape_classes()
+    proto = RTWPrototypeClassifier(method="dba", representation="velocity", cv=2).fit(X, y)
+    assert proto.centroids_.representation_ == "velocity"
+    assert proto.means_.shape[1] == X.shape[1] - 1
+    assert proto.predict(X).shape == (len(X),)

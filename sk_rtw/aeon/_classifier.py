@@ -87,6 +87,7 @@ class RTWClassifier(DelegatingClassifier):
         preset: str = "class-means",
         n_centroids: int | str = "auto",
         dtw_window: float | str | None = "auto",
+        representation: str = "raw",
         n_jobs: int | None = 1,
         random_state: int | np.random.RandomState | np.random.Generator | None = None,
         device: str | torch.device = "cpu",
@@ -98,6 +99,7 @@ class RTWClassifier(DelegatingClassifier):
         self.preset = preset
         self.n_centroids = n_centroids
         self.dtw_window = dtw_window
+        self.representation = representation
         self.n_jobs = n_jobs
         self.random_state = random_state
         self.device = device

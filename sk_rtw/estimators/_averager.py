@@ -14,7 +14,8 @@ from sklearn.utils.validation import check_is_fitted
 from .._settings import PRESETS
 from ..dtw import dtw_pairwise_distance
 from ..methods import FitContext, get_method
-from ..utils import check_series_collection
+from ..representations import represent, represented_manifold
+from ..utils import SeriesCollection, check_series_collection
 from ..utils._params import declare_parameters, validate_parameters
 from ._core import _label, fit_centroids
 from ._params import (
@@ -124,6 +125,7 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         preset: str = "class-means",
         n_centroids: int | str = 1,
         dtw_window: float | str | None = None,
+        representation: str = "raw",
         n_jobs: int | None = None,
         random_state: int | np.random.RandomState | np.random.Generator | None = None,
         device: str | torch.device = "cpu",
@@ -134,6 +136,7 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         self.preset = preset
         self.n_centroids = n_centroids
         self.dtw_window = dtw_window
+        self.representation = representation
         self.n_jobs = n_jobs
         self.random_state = random_state
         self.device = device
@@ -188,6 +191,11 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         )  # fmt: skip
         method.check_settings()  # every setting checked before any work
         collection = check_series_collection(X, self.manifold)
+        self.manifold_ = collection.manifold
+        self.representation_ = params["representation"]
+        if collection.equal_length and collection.manifold.point_shape == (1,):
+            self.n_features_in_ = collection.max_length
+        collection = represent(collection, self.representation_)
         if y is None:
             labels = np.zeros(collection.n_series, dtype=int)
         else:
@@ -228,7 +236,6 @@ class RTWAverager(TransformerMixin, BaseEstimator):
                              context, names=names, kind=kind, owner=owner)  # fmt: skip
         self.classes_ = classes
         self.method_ = method.label
-        self.manifold_ = collection.manifold
         self.dtw_window_ = window
         self.n_centroids_ = n_centroids
         self.alignments_ = fits
@@ -237,8 +244,6 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         means = [fit.mean for fit in fits]
         same_length = len({len(m) for m in means}) == 1
         self.means_ = np.stack(means) if same_length else means
-        if collection.equal_length and collection.manifold.point_shape == (1,):
-            self.n_features_in_ = collection.max_length
         if selection is None:
             return None
         return selection.held_out, codes[selection.sample]
@@ -256,11 +261,19 @@ class RTWAverager(TransformerMixin, BaseEstimator):
             n_jobs=params["n_jobs"], verbose=int(params["verbose"]), owner=type(self).__name__,
         )  # fmt: skip
 
+    def _represented(self, X: Any) -> tuple[SeriesCollection, SeriesCollection]:
+        """``X`` validated on the fitted manifold and the centroids, both in the fitted
+        representation."""
+        check_is_fitted(self, "means_")
+        shortest = 2 if self.representation_ == "velocity" else 1
+        collection = check_series_collection(X, self.manifold_, min_length=shortest)
+        space = represented_manifold(self.manifold_, self.representation_)
+        means = check_series_collection(self.means_, space, name="means_")
+        return represent(collection, self.representation_), means
+
     def _centroid_distances(self, X: Any) -> np.ndarray:
         """Manifold-DTW distance of every series to every entry of ``means_``."""
-        check_is_fitted(self, "means_")
-        collection = check_series_collection(X, self.manifold_, min_length=1)
-        means = check_series_collection(self.means_, self.manifold_, name="means_")
+        collection, means = self._represented(X)
         return dtw_pairwise_distance(collection, means, window=self.dtw_window_,
                                      n_jobs=self.n_jobs)  # fmt: skip
 
@@ -314,6 +327,7 @@ class TTWAverager(RTWAverager):
         preset: str = "class-means",
         n_centroids: int | str = 1,
         dtw_window: float | str | None = None,
+        representation: str = "raw",
         n_jobs: int | None = None,
         random_state: int | np.random.RandomState | np.random.Generator | None = None,
         device: str | torch.device = "cpu",
@@ -325,6 +339,7 @@ class TTWAverager(RTWAverager):
             preset=preset,
             n_centroids=n_centroids,
             dtw_window=dtw_window,
+            representation=representation,
             n_jobs=n_jobs,
             random_state=random_state,
             device=device,
@@ -357,6 +372,7 @@ class NTWAverager(RTWAverager):
         preset: str = "class-means",
         n_centroids: int | str = 1,
         dtw_window: float | str | None = None,
+        representation: str = "raw",
         n_jobs: int | None = None,
         random_state: int | np.random.RandomState | np.random.Generator | None = None,
         device: str | torch.device = "cpu",
@@ -368,6 +384,7 @@ class NTWAverager(RTWAverager):
             preset=preset,
             n_centroids=n_centroids,
             dtw_window=dtw_window,
+            representation=representation,
             n_jobs=n_jobs,
             random_state=random_state,
             device=device,

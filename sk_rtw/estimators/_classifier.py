@@ -12,7 +12,6 @@ from sklearn.base import ClassifierMixin
 from sklearn.utils.validation import check_is_fitted
 
 from ..dtw import dtw_nearest_distance
-from ..utils import check_series_collection
 from ..utils._params import declare_parameters
 from ._averager import RTWAverager, _check_labels, _encode
 from ._params import (
@@ -165,6 +164,7 @@ class RTWNearestCentroid(ClassifierMixin, RTWAverager):
         preset: str = "class-means",
         n_centroids: int | str = "auto",
         dtw_window: float | str | None = "auto",
+        representation: str = "raw",
         n_jobs: int | None = None,
         random_state: int | np.random.RandomState | np.random.Generator | None = None,
         device: str | torch.device = "cpu",
@@ -176,6 +176,7 @@ class RTWNearestCentroid(ClassifierMixin, RTWAverager):
         self.preset = preset
         self.n_centroids = n_centroids
         self.dtw_window = dtw_window
+        self.representation = representation
         self.n_jobs = n_jobs
         self.random_state = random_state
         self.device = device
@@ -239,9 +240,7 @@ class RTWNearestCentroid(ClassifierMixin, RTWAverager):
 
     def _nearest_centroids(self, X: Any, nearest_only: bool) -> np.ndarray:
         """:meth:`class_distances`, or only the nearest class's (``inf`` elsewhere)."""
-        check_is_fitted(self, "means_")
-        collection = check_series_collection(X, self.manifold_, min_length=1)
-        means = check_series_collection(self.means_, self.manifold_, name="means_")
+        collection, means = self._represented(X)
         return dtw_nearest_distance(
             collection, means, self.centroid_classes_, window=self.dtw_window_,
             nearest_only=nearest_only, n_jobs=self.n_jobs,
@@ -326,6 +325,7 @@ class TTWNearestCentroid(RTWNearestCentroid):
         preset: str = "class-means",
         n_centroids: int | str = "auto",
         dtw_window: float | str | None = "auto",
+        representation: str = "raw",
         n_jobs: int | None = None,
         random_state: int | np.random.RandomState | np.random.Generator | None = None,
         device: str | torch.device = "cpu",
@@ -338,6 +338,7 @@ class TTWNearestCentroid(RTWNearestCentroid):
             preset=preset,
             n_centroids=n_centroids,
             dtw_window=dtw_window,
+            representation=representation,
             n_jobs=n_jobs,
             random_state=random_state,
             device=device,
@@ -371,6 +372,7 @@ class NTWNearestCentroid(RTWNearestCentroid):
         preset: str = "class-means",
         n_centroids: int | str = "auto",
         dtw_window: float | str | None = "auto",
+        representation: str = "raw",
         n_jobs: int | None = None,
         random_state: int | np.random.RandomState | np.random.Generator | None = None,
         device: str | torch.device = "cpu",
@@ -383,6 +385,7 @@ class NTWNearestCentroid(RTWNearestCentroid):
             preset=preset,
             n_centroids=n_centroids,
             dtw_window=dtw_window,
+            representation=representation,
             n_jobs=n_jobs,
             random_state=random_state,
             device=device,

@@ -11,6 +11,7 @@ from dataclasses import replace
 
 from .._settings import DEVICE_PARAMETER, PRESET_PARAMETER, owners, settings_table
 from ..methods._registry import METHODS, method_parameter
+from ..representations import REPRESENTATIONS
 from ..utils._common_params import DTW_WINDOW as BAND
 from ..utils._common_params import MANIFOLD, N_JOBS, RANDOM_STATE, VERBOSE
 from ..utils._constraints import Interval, Options
@@ -43,6 +44,14 @@ DTW_WINDOW = replace(
     'training data with the centroids (fitted ``dtw_window_``) under "class-means" and '
     '"alignment", no band under "paper".',
 )
+REPRESENTATION = Parameter(
+    "representation",
+    (Options(REPRESENTATIONS),),
+    'What is averaged and compared: "raw" the series, "velocity" their tangent velocity '
+    "(sk_rtw.tangent_velocity: the manifold's derivative series, Euclidean vectors; the "
+    "centroids are then velocity series). The representation is applied to every series "
+    "the estimator is given, in fit and after.",
+)
 TEMPERATURE = Parameter(
     "temperature",
     (Interval(float, 0.0, closed="neither"), Options(("fit",))),
@@ -69,8 +78,8 @@ TOL = Parameter(
 
 #: The parameters of :class:`RTWAverager`, in signature order, with its defaults.
 AVERAGER_PARAMETERS = (
-    MANIFOLD, METHOD, PRESET_PARAMETER, N_CENTROIDS, DTW_WINDOW, N_JOBS, RANDOM_STATE,
-    DEVICE_PARAMETER, VERBOSE,
+    MANIFOLD, METHOD, PRESET_PARAMETER, N_CENTROIDS, DTW_WINDOW, REPRESENTATION, N_JOBS,
+    RANDOM_STATE, DEVICE_PARAMETER, VERBOSE,
 )  # fmt: skip
 AVERAGER_DEFAULTS = {
     "manifold": "euclidean",
@@ -78,6 +87,7 @@ AVERAGER_DEFAULTS = {
     "preset": "class-means",
     "n_centroids": 1,
     "dtw_window": None,
+    "representation": "raw",
     "n_jobs": None,
     "random_state": None,
     "device": "cpu",

@@ -14,7 +14,6 @@ from sklearn.utils import check_random_state
 from sklearn.utils.metaestimators import available_if
 from sklearn.utils.validation import check_is_fitted
 
-from ..utils import check_series_collection
 from ..utils._constraints import Constant, Interval, Options, Satisfies
 from ..utils._params import Parameter, declare_parameters, validate_parameters
 from ._averager import _check_labels, _encode
@@ -215,6 +214,7 @@ class RTWPrototypeClassifier(ClassifierMixin, TransformerMixin, BaseEstimator):
         preset: str = "class-means",
         n_centroids: int | str = "auto",
         dtw_window: float | str | None = "auto",
+        representation: str = "raw",
         n_jobs: int | None = None,
         random_state: int | np.random.RandomState | np.random.Generator | None = None,
         device: str | torch.device = "cpu",
@@ -228,6 +228,7 @@ class RTWPrototypeClassifier(ClassifierMixin, TransformerMixin, BaseEstimator):
         self.preset = preset
         self.n_centroids = n_centroids
         self.dtw_window = dtw_window
+        self.representation = representation
         self.n_jobs = n_jobs
         self.random_state = random_state
         self.device = device
@@ -281,7 +282,7 @@ class RTWPrototypeClassifier(ClassifierMixin, TransformerMixin, BaseEstimator):
         shared = {name: getattr(self, name) for name in CENTROID_PARAMETERS}
         centroids = RTWNearestCentroid(**{**shared, "random_state": seed}, temperature=1.0)
         centroids.fit(X, y)
-        collection = check_series_collection(X, centroids.manifold_)
+        collection, _ = centroids._represented(X)
         _, codes = _encode(_check_labels(y, collection.n_series, True))
         distances = out_of_fold_distances(
             centroids, collection, codes, params["cv"], random_state=seed,
