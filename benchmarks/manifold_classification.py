@@ -8,7 +8,12 @@ demonstration ``k`` of every shape and trains on the other three (4 folds, 30 cl
 
 * ``prototype``: ``RTWPrototypeClassifier(manifold=...)``, the library's defaults;
 * ``nearest-centroid``: ``RTWNearestCentroid(manifold=...)``, the library's defaults;
+* ``forest``: ``RTWProximityForest(manifold=...)``, the library's defaults (100 trees on
+  the series and their tangent velocity, one thread);
 * ``1nn-dtw``: 1-NN by manifold DTW (geodesic point cost, no band);
+* ``1nn-dtw-velocity``: 1-NN by DTW of the tangent velocity (``sk_rtw.tangent_velocity``:
+  the body angular velocity of the quaternions, the whitened logarithm of the SPD steps;
+  Euclidean point cost, no band);
 * ``minirocket``: aeon's ``MiniRocketClassifier`` on the coordinates (the 4 quaternion
   components; the 3 distinct entries of a 2 x 2 SPD matrix), which knows no manifold.
 
@@ -33,10 +38,16 @@ if __package__ in (None, ""):
 
 from benchmarks._shared import check_writable, machine, method_object
 from benchmarks.paper._data import data_dir, rlasa_quaternions, rlasa_shapes, rlasa_spd
-from sk_rtw import RTWNearestCentroid, RTWPrototypeClassifier, dtw_pairwise_distance
+from sk_rtw import (
+    RTWNearestCentroid,
+    RTWPrototypeClassifier,
+    RTWProximityForest,
+    dtw_pairwise_distance,
+    tangent_velocity,
+)
 
 SPACES = ("quaternion", "spd")
-ROWS = ("prototype", "nearest-centroid", "1nn-dtw", "minirocket")
+ROWS = ("prototype", "nearest-centroid", "forest", "1nn-dtw", "1nn-dtw-velocity", "minirocket")
 
 
 def load(space: str, root: Path, step: int) -> tuple[np.ndarray, np.ndarray]:
@@ -71,9 +82,20 @@ def run_fold(space, demos, shapes, fold, rows, method, seed, verbose) -> dict:
             start = time.perf_counter()
             predicted = model.predict(X_test)
             extra = {"decision": model.decision_} if row == "prototype" else {}
+        elif row == "forest":
+            model = RTWProximityForest(manifold=space, random_state=seed, n_jobs=1)
+            model.fit(X_train, y_train)
+            fit = time.perf_counter() - start
+            start = time.perf_counter()
+            predicted, extra = model.predict(X_test), {}
         elif row == "1nn-dtw":
             fit = 0.0
             D = dtw_pairwise_distance(X_test, X_train, manifold=space)
+            predicted, extra = y_train[D.argmin(1)], {}
+        elif row == "1nn-dtw-velocity":
+            fit = 0.0
+            D = dtw_pairwise_distance(tangent_velocity(X_test, space),
+                                      tangent_velocity(X_train, space))  # fmt: skip
             predicted, extra = y_train[D.argmin(1)], {}
         else:
             from aeon.classification.convolution_based import MiniRocketClassifier
@@ -107,6 +129,8 @@ def warm_up(rows) -> None:
             MiniRocketClassifier(random_state=0).fit(channels, y).predict(channels)
     if "prototype" in rows or "nearest-centroid" in rows:
         RTWNearestCentroid(method=method_object("rtw", n_epochs=2)).fit(X, y).predict(X)
+    if "forest" in rows:
+        RTWProximityForest(n_trees=2, random_state=0).fit(X, y).predict(X)
 
 
 def markdown(results: dict, args: argparse.Namespace, command: str) -> str:

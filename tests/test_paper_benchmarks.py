@@ -281,11 +281,11 @@ def test_manifold_classification_runs_one_fold(tmp_path):
         pytest.skip("the shared demonstration data is not next to the repository")
     page = tmp_path / "page.md"
     argv = ["--spaces", "quaternion", "spd", "--folds", "0", "--step", "50", "--method",
-            "dba", "--rows", "prototype", "nearest-centroid", "1nn-dtw", "--markdown",
-            str(page), "--quiet"]  # fmt: skip
+            "dba", "--rows", "prototype", "nearest-centroid", "forest", "1nn-dtw",
+            "1nn-dtw-velocity", "--markdown", str(page), "--quiet"]  # fmt: skip
     assert manifold_classification.main(argv) == 0
     text = page.read_text()
-    for row in ("prototype", "nearest-centroid", "1nn-dtw"):
+    for row in ("prototype", "nearest-centroid", "forest", "1nn-dtw", "1nn-dtw-velocity"):
         assert f"| quaternion | {row}" in text and f"| spd | {row}" in text
     coords = manifold_classification.coordinates(np.ones((2, 3, 2, 2)), "spd")
     assert coords.shape == (2, 3, 3)  # (n, channels, T): the three distinct entries
