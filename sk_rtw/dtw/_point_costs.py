@@ -153,6 +153,15 @@ _TINY, _HUGE = 1e-290, 1e290
 
 
 @njit(cache=True, nogil=True, inline="always")
+def _roots(row, n):
+    """Each of the ``n`` first point costs of ``row`` replaced by its square root: a
+    geodesic distance ``d`` becomes the cost ``d ** 0.5`` (the point-cost exponent 1/2
+    of Proximity Forest 2.0)."""
+    for j in range(n):
+        row[j] = math.sqrt(row[j])
+
+
+@njit(cache=True, nogil=True, inline="always")
 def _cost_row(x, y, i, ny, segments, squared, row):
     """Row ``i`` of the cost matrix: point costs between ``x[i]`` and ``y[:ny]``."""
     xi = x[i]
@@ -231,7 +240,7 @@ def segment_cost_stack(x, Y, nx, nys, segments, squared):
 
 
 @njit(cache=True, nogil=True)
-def diagonal_cost(x, y, segments, squared):
+def diagonal_cost(x, y, segments, squared, root=False):
     """The cost of the direct, diagonal alignment of flattened series ``x`` and ``y``.
 
     Equal lengths pair sample ``t`` with sample ``t``; unequal lengths step along the
@@ -240,6 +249,7 @@ def diagonal_cost(x, y, segments, squared):
     them off the diagonal, whose cost bounds the DTW distance from above (the costs
     summed in the recursion's order: along the diagonal of equal lengths, its value bit
     for bit). Amerced DTW scales its penalty by this cost (Herrmann and Webb, 2023).
+    ``root``: point costs are the square roots of the distances (``squared=False``).
     """
     nx, ny = x.shape[0], y.shape[0]
     steps = max(nx, ny)
@@ -248,16 +258,18 @@ def diagonal_cost(x, y, segments, squared):
     for t in range(steps):
         j = t * ny // steps
         _cost_row(x, y[j : j + 1], t * nx // steps, 1, segments, squared, cost)
+        if root:
+            _roots(cost, 1)
         total = cost[0] + total
     return total
 
 
 @njit(cache=True, nogil=True)
-def diagonal_costs(X, lengths, first, second, segments, squared):
+def diagonal_costs(X, lengths, first, second, segments, squared, root):
     """:func:`diagonal_cost` of series ``first[k]`` and ``second[k]`` of ``X`` (``(n, L,
     p)``, kernel form), for every ``k``."""
     out = np.empty(first.shape[0])
     for k in range(first.shape[0]):
         a, b = first[k], second[k]
-        out[k] = diagonal_cost(X[a, : lengths[a]], X[b, : lengths[b]], segments, squared)
+        out[k] = diagonal_cost(X[a, : lengths[a]], X[b, : lengths[b]], segments, squared, root)
     return out

@@ -6,8 +6,9 @@ penalty. :func:`prepare_series` puts a validated collection in the kernels' form
 (SPD blocks become their features, :mod:`._point_costs`); :meth:`PreparedSeries.take`
 selects series without validating them again; :func:`nearest_group` runs the package's
 nearest search (:mod:`._search`: LB_Keogh, early abandoning, the exhaustive answer) on
-the calling thread, for callers that run their own threads. A manifold without compiled
-point costs keeps its collection and takes the exhaustive search.
+the calling thread, for callers that run their own threads, with a point cost that is
+the geodesic distance to the power 1/2, 1 or 2 (:data:`EXPONENTS`). A manifold without
+compiled point costs keeps its collection and takes the exhaustive search.
 """
 
 from __future__ import annotations
@@ -18,9 +19,10 @@ from typing import Any
 import numpy as np
 
 from ..utils import SeriesCollection
-from . import _point_costs
+from . import _kernels, _point_costs
+from ._costs import point_cost_matrix
 from ._dtw import check_window
-from ._search import dtw_nearest_distance, nearest_by_class_serial
+from ._search import nearest_by_class_serial
 
 
 @dataclass(frozen=True, eq=False)
@@ -61,13 +63,25 @@ def prepare_series(collection: SeriesCollection) -> PreparedSeries:
                           segments, None)  # fmt: skip
 
 
+#: The point-cost exponents of the prepared searches: the point cost is the geodesic
+#: distance raised to one of them (Proximity Forest 2.0's cost-function exponents).
+EXPONENTS = (0.5, 1.0, 2.0)
+
+
+def _cost_flags(exponent: float) -> tuple[bool, bool]:
+    """The kernels' ``(squared, root)`` for a point-cost exponent of :data:`EXPONENTS`."""
+    if exponent not in EXPONENTS:
+        raise ValueError(f"the point-cost exponent must be one of {EXPONENTS}, got {exponent!r}")
+    return exponent == 2.0, exponent == 0.5
+
+
 def nearest_group(
     queries: PreparedSeries,
     references: PreparedSeries,
     groups: np.ndarray,
     n_groups: int,
     window: float | None,
-    squared: bool,
+    exponent: float,
     warp_penalty: float,
 ) -> np.ndarray:
     """For every query, the group of its nearest reference by DTW (amerced with
@@ -83,8 +97,8 @@ def nearest_group(
     n_groups : int
     window : float or None
         Sakoe-Chiba radius as a fraction of the shorter series; None: no band.
-    squared : bool
-        Squared point costs.
+    exponent : {0.5, 1.0, 2.0}
+        The point cost is the geodesic distance to this power.
     warp_penalty : float
         Amerced DTW's penalty, at least 0.
 
@@ -93,29 +107,45 @@ def nearest_group(
     nearest : ndarray of int, shape (n_queries,)
     """
     groups = np.ascontiguousarray(groups, dtype=np.int64)
-    if queries.segments is None:
-        assert queries.collection is not None and references.collection is not None
-        distances = dtw_nearest_distance(
-            queries.collection, references.collection, groups, window=window, squared=squared,
-            nearest_only=True, n_jobs=1, warp_penalty=warp_penalty,
-        )  # fmt: skip
-        return np.argmin(distances, axis=1)
+    squared, root = _cost_flags(exponent)
+    w = check_window(window)
     n = queries.n_series
+    if queries.segments is None:
+        return np.argmin(_exhaustive(queries, references, groups, n_groups, w, exponent,
+                                     float(warp_penalty)), axis=1)  # fmt: skip
     none = np.full(n, -1, dtype=np.int64)
     distances, _ = nearest_by_class_serial(
         queries.data, queries.lengths, references.data, references.lengths, groups, n_groups,
-        none, none, np.full(n, np.inf), False, queries.segments, bool(squared),
-        check_window(window), float(warp_penalty),
+        none, none, np.full(n, np.inf), False, queries.segments, squared, w,
+        float(warp_penalty), root,
     )  # fmt: skip
     return np.argmin(distances, axis=1)
 
 
+def _exhaustive(queries, references, groups, n_groups, window, exponent, penalty) -> np.ndarray:
+    """:func:`nearest_group`'s distances for a manifold without compiled point costs:
+    every pair's cost matrix from the manifold's distances, then the recursion."""
+    assert queries.collection is not None and references.collection is not None
+    out = np.full((queries.n_series, n_groups), np.inf)
+    manifold = queries.collection.manifold
+    for q in range(queries.n_series):
+        x = queries.collection.series(q)
+        for r in range(references.n_series):
+            y = references.collection.series(r)
+            costs = point_cost_matrix(x, y, manifold) ** exponent
+            value = _kernels.final_cost(costs, len(x), len(y), window, penalty)
+            out[q, groups[r]] = min(out[q, groups[r]], value)
+    return out
+
+
 def mean_diagonal_cost(
-    series: PreparedSeries, first: np.ndarray, second: np.ndarray, squared: bool
+    series: PreparedSeries, first: np.ndarray, second: np.ndarray, exponent: float
 ) -> float:
     """The mean cost of the direct (diagonal) alignment of the pairs ``(first[k],
-    second[k])`` of ``series`` (:func:`~._point_costs.diagonal_costs`): the scale of
-    amerced DTW's penalty (Herrmann and Webb, 2023)."""
+    second[k])`` of ``series`` (:func:`~._point_costs.diagonal_costs`), the point cost the
+    distance to ``exponent``: the scale of amerced DTW's penalty (Herrmann and Webb,
+    2023)."""
+    squared, root = _cost_flags(exponent)
     first = np.ascontiguousarray(first, dtype=np.int64)
     second = np.ascontiguousarray(second, dtype=np.int64)
     if series.segments is None:  # the manifold's own distance along the diagonal
@@ -127,8 +157,8 @@ def mean_diagonal_cost(
             steps = max(len(x), len(y))
             t = np.arange(steps)
             cost = np.asarray(manifold.dist(x[t * len(x) // steps], y[t * len(y) // steps]))
-            total += float((cost * cost).sum() if squared else cost.sum())
+            total += float((cost**exponent).sum())
         return total / max(1, len(first))
     costs = _point_costs.diagonal_costs(series.data, series.lengths, first, second,
-                                        series.segments, bool(squared))  # fmt: skip
+                                        series.segments, squared, root)  # fmt: skip
     return float(costs.mean()) if len(costs) else 0.0

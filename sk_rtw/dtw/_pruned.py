@@ -15,8 +15,16 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from ._kernels import _amerced_cell, _band_row, _cell, _two_rows, choose_step, sakoe_chiba_rows
-from ._point_costs import _cost_row
+from ._kernels import (
+    _amerced_cell,
+    _band_row,
+    _cell,
+    _recurrence,
+    _two_rows,
+    choose_step,
+    sakoe_chiba_rows,
+)
+from ._point_costs import _cost_row, _roots
 
 _INF = np.inf
 
@@ -27,12 +35,14 @@ PRUNE_CHUNK = 32
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _pruned_row(x, y, i, prev, cur, costs, lo, hi, reach, bound, segments, squared, penalty):
+def _pruned_row(x, y, i, prev, cur, costs, lo, hi, reach, bound, segments, squared, penalty,
+                root):  # fmt: skip
     """Row ``i`` of the accumulated cost into ``cur`` (padded as in :func:`_accumulate_row`)
     from column ``lo`` on, skipping what cannot beat ``bound`` (PrunedDTW: Silva and
     Batista, 2016). ``costs`` is a scratch row of at least ``hi`` entries; ``penalty`` is
     amerced DTW's (:func:`~._kernels._cell`: a non-negative penalty keeps every argument
-    below).
+    below); with ``root`` every point cost is the square root of its distance
+    (:func:`~._point_costs._roots`; with ``squared=False``).
 
     A cell is "kept" when its accumulated cost is at most ``bound``. ``reach`` is the last
     kept column of the row above plus one: past it the cells above and above-left exceed
@@ -42,25 +52,41 @@ def _pruned_row(x, y, i, prev, cur, costs, lo, hi, reach, bound, segments, squar
     """
     if bound == _INF:  # nothing to skip: the plain recursion
         _cost_row(x, y[lo:hi], i, hi - lo, segments, squared, costs[lo:hi])
+        if root:
+            _roots(costs[lo:hi], hi - lo)
         _band_row(costs, prev, cur, lo, hi, penalty)
         return lo, hi - 1, hi - 1
-    left = _INF
     first, last = -1, -1
-    for chunk in range(lo, hi, PRUNE_CHUNK):
+    # before ``reach`` no cell ends the row: the plain recursion, then a scan for the kept
+    # cells (checks inside the recursion's chain of dependencies cost twice the cells)
+    before = min(hi, max(lo, reach))
+    left = _INF
+    if before > lo:
+        _cost_row(x, y[lo:before], i, before - lo, segments, squared, costs[lo:before])
+        if root:
+            _roots(costs[lo:before], before - lo)
+        left = _recurrence(costs, prev, cur, lo, before, _INF, penalty)
+        for j in range(lo, before):
+            if cur[j + 1] <= bound:
+                if first < 0:
+                    first = j
+                last = j
+    for chunk in range(before, hi, PRUNE_CHUNK):
         stop = min(hi, chunk + PRUNE_CHUNK)
         _cost_row(x, y[chunk:stop], i, stop - chunk, segments, squared, costs[chunk:stop])
+        if root:
+            _roots(costs[chunk:stop], stop - chunk)
         for j in range(chunk, stop):
             if penalty == 0.0:
                 left = _cell(prev, left, j, costs[j])
             else:
                 left = _amerced_cell(prev, left, j, costs[j], penalty)
             cur[j + 1] = left
-            if left <= bound:
-                if first < 0:
-                    first = j
-                last = j
-            elif j >= reach:
+            if left > bound:  # past ``reach``: every cell to its right exceeds it too
                 return first, last, j
+            if first < 0:
+                first = j
+            last = j
     return first, last, hi - 1
 
 
@@ -83,7 +109,7 @@ def accumulated_segment_cost(x, y, segments, squared, window, bound):
     in ``values[offsets[i]:offsets[i + 1]]`` (:func:`ragged_value` reads a cell).
     """
     lo, hi = sakoe_chiba_rows(x.shape[0], y.shape[0], window)
-    return _pruned_rows(x, y, segments, squared, lo, hi, bound, True, 0.0)[:3]
+    return _pruned_rows(x, y, segments, squared, lo, hi, bound, True, 0.0, False, None)[:3]
 
 
 @njit(cache=True, nogil=True)
@@ -92,7 +118,7 @@ def band_segment_cost(x, y, segments, squared, lo, hi):
     ``lo[i] <= j < hi[i]`` (``lo`` and ``hi`` non-decreasing, ``lo[0] = 0``,
     ``hi[-1] = len(y)``), every cell of it computed; the same ``(values, offsets,
     starts)`` rows."""
-    return _pruned_rows(x, y, segments, squared, lo, hi, _INF, True, 0.0)[:3]
+    return _pruned_rows(x, y, segments, squared, lo, hi, _INF, True, 0.0, False, None)[:3]
 
 
 @njit(cache=True, nogil=True)
@@ -115,11 +141,15 @@ def band_accumulated_cost(costs, lo, hi):
 
 
 @njit(cache=True, nogil=True)
-def pruned_distance(x, y, segments, squared, window, bound, penalty=0.0):
+def pruned_distance(x, y, segments, squared, window, bound, penalty=0.0, root=False,
+                    tails=None):  # fmt: skip
     """The DTW distance of flattened series ``x`` and ``y`` in two rows of memory, the
     cells that cannot beat ``bound`` skipped as in :func:`accumulated_segment_cost`:
     exact when at most ``bound``, otherwise some value above it (``inf`` if the bound
-    was too low). ``penalty``: amerced DTW's, on every step off the diagonal (0: DTW)."""
+    was too low). ``penalty``: amerced DTW's, on every step off the diagonal (0: DTW);
+    ``root``: point costs are the square roots of the distances; ``tails[i]``: a lower
+    bound of the cost of the rows after row ``i`` (:func:`~._search.row_tails`), which
+    skips the cells that cannot beat ``bound`` earlier (the same value)."""
     if bound == _INF:  # the plain recursion, without the pruning's bookkeeping per row
         lo, hi = sakoe_chiba_rows(x.shape[0], y.shape[0], window)
         prev, cur = _two_rows(y.shape[0])
@@ -127,18 +157,21 @@ def pruned_distance(x, y, segments, squared, window, bound, penalty=0.0):
         for i in range(x.shape[0]):
             _cost_row(x, y[lo[i] : hi[i]], i, hi[i] - lo[i], segments, squared,
                       costs[lo[i] : hi[i]])  # fmt: skip
+            if root:
+                _roots(costs[lo[i] : hi[i]], hi[i] - lo[i])
             _band_row(costs, prev, cur, lo[i], hi[i], penalty)
             prev, cur = cur, prev
         return prev[y.shape[0]]
     lo, hi = sakoe_chiba_rows(x.shape[0], y.shape[0], window)
-    return _pruned_rows(x, y, segments, squared, lo, hi, bound, False, penalty)[3]
+    return _pruned_rows(x, y, segments, squared, lo, hi, bound, False, penalty, root, tails)[3]
 
 
 @njit(cache=True, nogil=True)
-def _pruned_rows(x, y, segments, squared, lo, hi, bound, store, penalty):
+def _pruned_rows(x, y, segments, squared, lo, hi, bound, store, penalty, root, tails):
     """Rows of the accumulated cost in two buffers, each kept in ``values`` if ``store``:
     ``(values, offsets, starts, last cell)`` (see :func:`accumulated_segment_cost`), in
-    the staircase band ``[lo[i], hi[i])``, off-diagonal steps amerced by ``penalty``."""
+    the staircase band ``[lo[i], hi[i])``, off-diagonal steps amerced by ``penalty``;
+    with ``tails`` (or None), row ``i`` keeps the cells within ``bound - tails[i]``."""
     nx, ny = x.shape[0], y.shape[0]
     prev, cur = _two_rows(ny)
     costs = np.empty(ny)
@@ -151,9 +184,11 @@ def _pruned_rows(x, y, segments, squared, lo, hi, bound, store, penalty):
     for i in range(nx):
         a = max(lo[i], start)
         cur[a] = _INF  # column a - 1, which the next row reads and this one does not write
+        row_bound = bound if tails is None else bound - tails[i]
         first, last, written = _pruned_row(
-            x, y, i, prev, cur, costs, a, hi[i], reach, bound, segments, squared, penalty
-        )
+            x, y, i, prev, cur, costs, a, hi[i], reach, row_bound, segments, squared, penalty,
+            root,
+        )  # fmt: skip
         for k in range(written + 2, cur_end + 1):  # what two rows ago left further right
             cur[k] = _INF
         cur_end = max(written + 1, a)

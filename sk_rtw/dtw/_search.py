@@ -132,51 +132,80 @@ def _outside(value, low, high):
     return 0.0
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _box_cost(point, lower, upper, segments, squared, root):
+    """A lower bound of the point cost between ``point`` (``(p,)``, kernel form) and any
+    point whose coordinates lie in ``[lower, upper]`` (module docstring: the gap to the
+    box, turned into a bound on the segment's distance; ``root``: costs are the square
+    roots of the distances, an increasing function of them too)."""
+    n_segments = segments.shape[0]
+    if n_segments == 1 and segments[0, 2] == _point_costs.SEGMENT_EUCLIDEAN and (
+        segments[0, 1] == 1
+    ):
+        gap = _outside(point[0], lower[0], upper[0])
+        if root:
+            gap = math.sqrt(gap)
+        return gap * gap if squared else gap
+    sq = 0.0
+    for s in range(n_segments):
+        start, stop, code = segments[s, 0], segments[s, 1], segments[s, 2]
+        near = 0.0
+        if code >= _point_costs.SEGMENT_SPD2:  # the sorted log-eigenvalues
+            stop = start + _point_costs.spd_size(code)
+        for k in range(start, stop):
+            gap = _outside(point[k], lower[k], upper[k])
+            near += gap * gap
+        if code == _point_costs.SEGMENT_EUCLIDEAN:
+            sq += near
+            continue
+        if code >= _point_costs.SEGMENT_SPD2:
+            sq += near * SPD_BOUND_SHRINK
+            continue
+        if code == _point_costs.SEGMENT_SIGN_INVARIANT_SPHERE:
+            flipped = 0.0  # the envelope of -x is [-upper, -lower]
+            for k in range(start, stop):
+                gap = _outside(point[k], -upper[k], -lower[k])
+                flipped += gap * gap
+            near = min(near, flipped)
+        angle = 2.0 * math.asin(min(1.0, 0.5 * math.sqrt(near)))
+        sq += angle * angle
+    near = sq if squared else math.sqrt(sq)
+    return math.sqrt(near) if root else near
+
+
 @njit(cache=True, nogil=True)
-def lb_keogh(y, lower, upper, segments, squared):
+def lb_keogh(y, lower, upper, segments, squared, root=False):
     """LB_Keogh of reference ``y`` (``(T_y, p)``) against a query's envelope
     (:func:`query_envelope`), in the point cost of ``segments`` (module docstring)."""
-    ny = y.shape[0]
     total = 0.0
-    n_segments = segments.shape[0]
-    univariate = n_segments == 1 and segments[0, 2] == _point_costs.SEGMENT_EUCLIDEAN and (
-        segments[0, 1] == 1
-    )
-    for j in range(ny):
-        if univariate:
-            gap = _outside(y[j, 0], lower[j, 0], upper[j, 0])
-            total += gap * gap if squared else gap
-        else:
-            sq = 0.0
-            for s in range(n_segments):
-                start, stop, code = segments[s, 0], segments[s, 1], segments[s, 2]
-                near = 0.0
-                if code >= _point_costs.SEGMENT_SPD2:  # the sorted log-eigenvalues
-                    stop = start + _point_costs.spd_size(code)
-                for k in range(start, stop):
-                    gap = _outside(y[j, k], lower[j, k], upper[j, k])
-                    near += gap * gap
-                if code == _point_costs.SEGMENT_EUCLIDEAN:
-                    sq += near
-                    continue
-                if code >= _point_costs.SEGMENT_SPD2:
-                    sq += near * SPD_BOUND_SHRINK
-                    continue
-                if code == _point_costs.SEGMENT_SIGN_INVARIANT_SPHERE:
-                    flipped = 0.0  # the envelope of -x is [-upper, -lower]
-                    for k in range(start, stop):
-                        gap = _outside(y[j, k], -upper[j, k], -lower[j, k])
-                        flipped += gap * gap
-                    near = min(near, flipped)
-                angle = 2.0 * math.asin(min(1.0, 0.5 * math.sqrt(near)))
-                sq += angle * angle
-            total += sq if squared else math.sqrt(sq)
+    for j in range(y.shape[0]):
+        total += _box_cost(y[j], lower[j], upper[j], segments, squared, root)
     return total
+
+
+@njit(cache=True, nogil=True)
+def row_tails(x, y, window, segments, squared, root, lower, upper, scratch, tails):
+    """``tails[i]``: a lower bound of the cost of rows ``i + 1 .. T_x - 1`` of any
+    warping path between ``x`` and ``y`` (the UCR suite's cumulative bound, by rows).
+
+    Every row holds a cell of the path, whose cost is at least that of ``x[i]`` to the
+    box of the reference's samples in the row's band (the envelope of ``y`` seen from
+    ``x``'s rows, :func:`_envelope`). A cell whose accumulated cost exceeds the bound
+    less its row's tail cannot lie on a path within the bound: PrunedDTW skips it
+    (:func:`~sk_rtw.dtw._pruned.pruned_distance`). ``lower``, ``upper`` (at least
+    ``(T_x, p)``) and ``scratch`` (``4 T_y + 2 T_x`` integers) are work space.
+    """
+    nx = x.shape[0]
+    _envelope(y, nx, window, lower, upper, scratch)
+    total = 0.0
+    for i in range(nx - 1, -1, -1):
+        tails[i] = total * (1.0 - LB_SLACK)
+        total += _box_cost(x[i], lower[i], upper[i], segments, squared, root)
 
 
 def _nearest_by_class(
     Q, lq, R, lr, owners, n_classes, skip_reference, skip_class, limits, every_class,
-    segments, squared, window, penalty,
+    segments, squared, window, penalty, root,
 ):  # fmt: skip
     """DTW distance of every query to the nearest reference of every class (module
     docstring), the values of the exhaustive search.
@@ -187,7 +216,8 @@ def _nearest_by_class(
     distances above ``limits[q]``. With ``every_class`` every class's nearest distance is
     computed; otherwise only the nearest class's (and those tied with it), the others
     left ``inf``. ``penalty`` is amerced DTW's (0: DTW; LB_Keogh bounds both, a penalty
-    only adds to a path's cost). Returns the distances ``(n_q, n_classes)`` (``inf``
+    only adds to a path's cost); ``root``: the point costs are the square roots of the
+    distances (``squared=False``). Returns the distances ``(n_q, n_classes)`` (``inf``
     where none was wanted or left) and the number of exact DTWs computed per query.
     """
     n_q, n_r, p = Q.shape[0], R.shape[0], Q.shape[2]
@@ -196,9 +226,11 @@ def _nearest_by_class(
     by_length = np.argsort(lr, kind="mergesort")  # envelopes computed once per length
     for q in prange(n_q):
         x = Q[q, : lq[q]]
-        lower = np.empty((R.shape[1], p))
-        upper = np.empty((R.shape[1], p))
-        scratch = np.empty(4 * lq[q] + 2 * R.shape[1], dtype=np.int64)
+        longest = max(R.shape[1], lq[q])
+        lower = np.empty((longest, p))
+        upper = np.empty((longest, p))
+        scratch = np.empty(4 * longest + 2 * longest, dtype=np.int64)
+        tails = np.empty(lq[q])
         candidates = np.empty(n_r, dtype=np.int64)
         bounds = np.empty(n_r)
         available = np.zeros(n_classes, dtype=np.bool_)
@@ -211,7 +243,7 @@ def _nearest_by_class(
                 current = lr[r]
                 _envelope(x, current, window, lower, upper, scratch)
             candidates[n] = r
-            bounds[n] = lb_keogh(R[r, : lr[r]], lower, upper, segments, squared)
+            bounds[n] = lb_keogh(R[r, : lr[r]], lower, upper, segments, squared, root)
             available[owners[r]] = True
             n += 1
         best = out[q]
@@ -230,13 +262,16 @@ def _nearest_by_class(
             cut = threshold
             if (window < 0.0 or window >= 1.0 or x.shape[0] == y.shape[0]) and cut > 0.0:
                 # the diagonal path lies in the band: its cost bounds this pair's distance
-                upper = _point_costs.diagonal_cost(x, y, segments, squared)
-                upper += penalty * abs(x.shape[0] - y.shape[0])
-                cut = min(cut, upper * (1.0 + LB_SLACK))
-            value = _pruned.pruned_distance(x, y, segments, squared, window, cut, penalty)
+                diagonal = _point_costs.diagonal_cost(x, y, segments, squared, root)
+                diagonal += penalty * abs(x.shape[0] - y.shape[0])
+                cut = min(cut, diagonal * (1.0 + LB_SLACK))
+            if cut < _INF:
+                row_tails(x, y, window, segments, squared, root, lower, upper, scratch, tails)
+            value = _pruned.pruned_distance(x, y, segments, squared, window, cut, penalty, root,
+                                            tails)  # fmt: skip
             if value > cut and cut < threshold:  # rounding beat the slack: bound it again
                 value = _pruned.pruned_distance(x, y, segments, squared, window, threshold,
-                                                penalty)  # fmt: skip
+                                                penalty, root, tails)  # fmt: skip
             computed[q] += 1
             if value <= threshold and value < best[c]:
                 best[c] = value
@@ -375,7 +410,7 @@ def _nearest(X, Y, groups, manifold, window, squared, exclude, exclude_group, ma
         return nearest_by_class(
             _point_costs.kernel_series(cx), cx.lengths, _point_costs.kernel_series(cy), cy.lengths,
             owners, n_groups, skip,
-            skip_group, limits, not nearest_only, segments, bool(squared), w, penalty,
+            skip_group, limits, not nearest_only, segments, bool(squared), w, penalty, False,
         )  # fmt: skip
 
 
