@@ -13,8 +13,9 @@ from sklearn.pipeline import Pipeline
 from sklearn.preprocessing import FunctionTransformer
 from sklearn.utils.estimator_checks import parametrize_with_checks
 
-from sk_rtw import RTWProximityForest, dtw_distance, tangent_velocity
+from sk_rtw import RTWProximityForest, tangent_velocity
 from sk_rtw.dtw import mean_diagonal_cost, nearest_group, prepare_series
+from sk_rtw.dtw._kernels import sakoe_chiba_rows
 from sk_rtw.estimators._proximity_split import (
     Measure,
     NodeSeries,
@@ -95,10 +96,24 @@ def test_predict_proba_is_the_mean_of_the_trees_leaves():
     assert forest.score(test, test_y) >= 0.9
 
 
+def reference_adtw(x, y, manifold, penalty, window, exponent):
+    """Textbook amerced DTW in a Sakoe-Chiba band, point cost the distance to
+    ``exponent``, with Python loops (the band from the package's own row ranges)."""
+    nx, ny = len(x), len(y)
+    lo, hi = sakoe_chiba_rows(nx, ny, -1.0 if window is None else window)
+    D = np.full((nx + 1, ny + 1), np.inf)
+    D[0, 0] = 0.0
+    for i in range(nx):
+        for j in range(lo[i], hi[i]):
+            c = float(manifold.dist(x[i], y[j])) ** exponent
+            D[i + 1, j + 1] = c + min(D[i, j], D[i, j + 1] + penalty, D[i + 1, j] + penalty)
+    return D[nx, ny]
+
+
 def _brute_force_branches(series, exemplars, measure, manifold):
-    def distance(s, e):
-        return dtw_distance(s, e, manifold, window=measure.window, squared=measure.squared,
-                            warp_penalty=measure.warp_penalty)  # fmt: skip
+    def distance(x, y):
+        return reference_adtw(x, y, manifold, measure.warp_penalty, measure.window,
+                              measure.exponent)  # fmt: skip
 
     return np.array([[distance(s, e) for e in exemplars] for s in series]).argmin(1)
 
@@ -143,7 +158,7 @@ def test_gini_and_its_gain_by_hand():
 def test_the_penalty_scale_is_the_mean_direct_alignment_cost(rng):
     X = [rng.standard_normal(n) for n in (20, 20, 26)]
     prepared = prepare_series(check_series_collection(X))
-    got = mean_diagonal_cost(prepared, np.array([0, 2]), np.array([1, 0]), squared=True)
+    got = mean_diagonal_cost(prepared, np.array([0, 2]), np.array([1, 0]), 2.0)
     t = np.arange(26)
     unequal = ((X[2] - X[0][t * 20 // 26]) ** 2).sum()  # the longer series steps
     assert got == pytest.approx((((X[0] - X[1]) ** 2).sum() + unequal) / 2, rel=1e-12)
@@ -153,19 +168,23 @@ def test_the_penalty_scale_is_the_mean_direct_alignment_cost(rng):
     prepared = prepare_series(check_series_collection(Y, M))
     assert prepared.segments is None
     step = np.arange(7) * 5 // 7
-    assert mean_diagonal_cost(prepared, np.array([0]), np.array([1]), False) == pytest.approx(
+    assert mean_diagonal_cost(prepared, np.array([0]), np.array([1]), 1.0) == pytest.approx(
         float(M.dist(Y[0][step], Y[1]).sum()), rel=1e-12
     )
+    root = mean_diagonal_cost(prepare_series(check_series_collection(X)), np.array([0]),
+                              np.array([1]), 0.5)  # fmt: skip
+    assert root == pytest.approx(np.sqrt(np.abs(X[0] - X[1])).sum(), rel=1e-12)
 
 
 def test_nearest_group_on_a_manifold_without_compiled_costs_matches_the_kernels():
     M = Product((Sphere(2), SPD(13)))
     X = np.stack([random_walk(M, 6, s) for s in range(5)])
     prepared = prepare_series(check_series_collection(X, M))
-    got = nearest_group(prepared.take([0, 1, 2]), prepared.take([3, 4]), np.array([0, 1]), 2,
-                        0.2, False, 0.1)  # fmt: skip
-    expected = _brute_force_branches(X[:3], X[3:], Measure("raw", 0.2, False, 0.1), M)
-    np.testing.assert_array_equal(got, expected)
+    for exponent in (0.5, 1.0, 2.0):
+        got = nearest_group(prepared.take([0, 1, 2]), prepared.take([3, 4]), np.array([0, 1]),
+                            2, 0.2, exponent, 0.1)  # fmt: skip
+        expected = _brute_force_branches(X[:3], X[3:], Measure("raw", 0.2, exponent, 0.1), M)
+        np.testing.assert_array_equal(got, expected)
 
 
 @pytest.mark.parametrize(

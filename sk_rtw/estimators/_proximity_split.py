@@ -8,7 +8,8 @@ DTW (:mod:`sk_rtw.dtw`), drawn as Proximity Forest 2.0 draws its DTW family:
 
 * the representation, uniformly: the series (``"raw"``) or their tangent velocity
   (:func:`sk_rtw.tangent_velocity`, the manifold's derivative series);
-* the point cost, uniformly: the geodesic distance or its square;
+* the point cost, uniformly: the geodesic distance to the power 1/2, 1 or 2
+  (:data:`COST_EXPONENTS`, Proximity Forest 2.0's cost-function exponents);
 * the measure, uniformly: DTW in a Sakoe-Chiba band of radius uniform in
   ``[0, MAX_WINDOW]`` of the length, or amerced DTW without a band, its penalty
   ``(i / PENALTY_STEPS) ** PENALTY_EXPONENT`` times the mean cost of the direct alignment
@@ -22,9 +23,9 @@ DTW (:mod:`sk_rtw.dtw`), drawn as Proximity Forest 2.0 draws its DTW family:
 
 The nearest exemplar is found by the package's nearest search (:func:`sk_rtw.dtw.
 nearest_group`: lower bounds, early abandoning, the exhaustive search's answer; a tie
-goes to the branch of the lowest class). Proximity Forest 2.0 also draws LCSS and a
-cost exponent of 1/2, and samples the penalty's scale once from the whole training set;
-the scale here is the node's own.
+goes to the branch of the lowest class). Proximity Forest 2.0 also draws LCSS, and
+samples the penalty's scale once from the whole training set; the scale here is the
+node's own.
 """
 
 from __future__ import annotations
@@ -52,23 +53,28 @@ MEAN_SUBSET = 10
 MEAN_ITERATIONS = 5
 #: The measures drawn: DTW in a band, amerced DTW without one.
 MEASURES = ("dtw", "adtw")
+#: The point cost is the geodesic distance to one of these powers.
+COST_EXPONENTS = (0.5, 1.0, 2.0)
 
 
 @dataclass(frozen=True)
 class Measure:
     """A drawn measure: the representation compared, the Sakoe-Chiba radius (None: no
-    band), squared point costs or not, amerced DTW's penalty (0: DTW)."""
+    band), the point cost's exponent (the geodesic distance to that power), amerced DTW's
+    penalty (0: DTW)."""
 
     representation: str
     window: float | None
-    squared: bool
+    exponent: float
     warp_penalty: float
 
     def __str__(self) -> str:
         name = "DTW" if self.warp_penalty == 0 else f"ADTW (penalty {self.warp_penalty:.3g})"
         band = "no band" if self.window is None else f"band {self.window:.3f}"
-        cost = "squared" if self.squared else "geodesic"
-        return f"{name} on the {self.representation} series, {band}, {cost} point costs"
+        return (
+            f"{name} on the {self.representation} series, {band}, point cost the distance "
+            f"to the power {self.exponent:g}"
+        )
 
 
 @dataclass(frozen=True, eq=False)
@@ -110,7 +116,7 @@ class NodeSeries:
     indices: np.ndarray
     codes: np.ndarray
     prepared: dict[str, PreparedSeries] = field(default_factory=dict)
-    scales: dict[tuple[str, bool], float] = field(default_factory=dict)
+    scales: dict[tuple[str, float], float] = field(default_factory=dict)
 
     def series(self, data: dict[str, PreparedSeries], representation: str) -> PreparedSeries:
         if representation not in self.prepared:
@@ -118,18 +124,18 @@ class NodeSeries:
         return self.prepared[representation]
 
     def penalty_scale(
-        self, data: dict[str, PreparedSeries], representation: str, squared: bool,
+        self, data: dict[str, PreparedSeries], representation: str, exponent: float,
         rng: np.random.Generator,
     ) -> float:  # fmt: skip
         """The mean cost of the direct alignment of :data:`PENALTY_PAIRS` random pairs of
         distinct series of the node (drawn once per representation and point cost)."""
-        key = (representation, squared)
+        key = (representation, exponent)
         if key not in self.scales:
             n = len(self.indices)
             first = rng.integers(n, size=PENALTY_PAIRS)
             second = (first + 1 + rng.integers(n - 1, size=PENALTY_PAIRS)) % n
             self.scales[key] = mean_diagonal_cost(
-                data[representation], self.indices[first], self.indices[second], squared
+                data[representation], self.indices[first], self.indices[second], exponent
             )
         return self.scales[key]
 
@@ -142,13 +148,13 @@ def draw_measure(
 ) -> Measure:
     """One measure, drawn as the module docstring says."""
     representation = representations[int(rng.integers(len(representations)))]
-    squared = bool(rng.integers(2))
+    exponent = COST_EXPONENTS[int(rng.integers(len(COST_EXPONENTS)))]
     if MEASURES[int(rng.integers(len(MEASURES)))] == "dtw":
-        return Measure(representation, float(rng.uniform(0.0, MAX_WINDOW)), squared, 0.0)
+        return Measure(representation, float(rng.uniform(0.0, MAX_WINDOW)), exponent, 0.0)
     step = int(rng.integers(PENALTY_STEPS))
-    scale = node.penalty_scale(data, representation, squared, rng)
+    scale = node.penalty_scale(data, representation, exponent, rng)
     penalty = (step / PENALTY_STEPS) ** PENALTY_EXPONENT * scale
-    return Measure(representation, None, squared, float(penalty))
+    return Measure(representation, None, exponent, float(penalty))
 
 
 def _mean_exemplars(
@@ -206,7 +212,7 @@ def best_split(
             references, means = data[measure.representation].take(exemplars), None
         branches = nearest_group(
             node.series(data, measure.representation), references,
-            np.arange(len(present)), len(present), measure.window, measure.squared,
+            np.arange(len(present)), len(present), measure.window, measure.exponent,
             measure.warp_penalty,
         )  # fmt: skip
         gain = gini_gain(node.codes, branches, len(present), n_classes)

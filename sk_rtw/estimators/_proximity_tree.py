@@ -162,7 +162,7 @@ class ProximityTree:
             branches = nearest_group(
                 data[measure.representation].take(indices), references,
                 np.arange(len(split.classes)), len(split.classes), measure.window,
-                measure.squared, measure.warp_penalty,
+                measure.exponent, measure.warp_penalty,
             )  # fmt: skip
             for branch, child in enumerate(node.children):
                 members = indices[branches == branch]

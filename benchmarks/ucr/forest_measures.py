@@ -1,0 +1,82 @@
+"""The proximity forest's measure family: each variant of the draw, on the halves.
+
+Usage::
+
+    python benchmarks/ucr/forest_measures.py --data-dir ../shared/ucr --halves A --seeds 0 1 2 \
+        --variants default exponents-1-2 --out results/forest_measures.jsonl
+
+For every dataset, seed and variant, :class:`sk_rtw.RTWProximityForest(random_state=seed,
+n_jobs=1)` is fitted on one thread with its measure family changed as the variant says,
+and its test accuracy, fit and prediction seconds are kept (JSON lines, appended as each
+dataset finishes; a rerun skips what is there). The mean accuracy per half and seed is
+printed. Variants:
+
+* ``default``: the forest as shipped (point-cost exponents 1/2, 1 and 2);
+* ``exponents-1-2``: the geodesic distance or its square only (the issue's first draft,
+  without Proximity Forest 2.0's exponent 1/2).
+
+This script changes the module constant of the draw (:data:`sk_rtw.estimators.
+_proximity_split.COST_EXPONENTS`): the exponents are the recipe, not a parameter a user
+tunes, so the study reaches into the module to measure the alternative.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the repository
+
+from benchmarks.ucr._data import load_split
+from benchmarks.ucr._halves_cli import (
+    halves_parser,
+    measure_missing,
+    print_half_means,
+    read_records,
+)
+from sk_rtw import RTWProximityForest
+from sk_rtw.estimators import _proximity_split
+
+VARIANTS = {"default": _proximity_split.COST_EXPONENTS, "exponents-1-2": (1.0, 2.0)}
+
+
+def measure(name: str, seed: int, data_dir: str, variants: list[str]) -> dict:
+    train, test = load_split(name, "train", data_dir), load_split(name, "test", data_dir)
+    record: dict = {"dataset": name, "seed": seed}
+    for variant in variants:
+        _proximity_split.COST_EXPONENTS = VARIANTS[variant]
+        try:
+            forest = RTWProximityForest(random_state=seed, n_jobs=1)
+            start = time.perf_counter()
+            forest.fit(train.X, train.y)
+            fit = time.perf_counter() - start
+            start = time.perf_counter()
+            predictions = forest.predict(test.X)
+            record[variant] = float(np.mean(predictions == test.y))
+            record[f"{variant}_fit"] = fit
+            record[f"{variant}_predict"] = time.perf_counter() - start
+        finally:
+            _proximity_split.COST_EXPONENTS = VARIANTS["default"]
+    print(name, seed, {v: round(record[v], 4) for v in variants}, flush=True)
+    return record
+
+
+def main(argv=None) -> None:
+    parser = halves_parser(__doc__.splitlines()[0], out_required=False)
+    parser.add_argument("--variants", nargs="+", default=list(VARIANTS), choices=list(VARIANTS))
+    args = parser.parse_args(argv)
+    records = [r for r in read_records(args.out) if all(v in r for v in args.variants)]
+
+    def one(name: str, seed: int, data_dir: str) -> dict:
+        return measure(name, seed, data_dir, args.variants)
+
+    for _ in measure_missing(args, records, one):
+        pass
+    print_half_means(records, args, args.variants)
+
+
+if __name__ == "__main__":
+    main()
