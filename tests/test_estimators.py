@@ -477,3 +477,22 @@ def test_prototype_classifier_passes_the_representation_on():
     assert proto.centroids_.representation_ == "velocity"
     assert proto.means_.shape[1] == X.shape[1] - 1
     assert proto.predict(X).shape == (len(X),)
+
+
+def test_auto_representation_is_chosen_with_the_band():
+    """Two shapes under random offsets far larger than the shapes: the velocity (which
+    drops the offsets) classifies the held-out series better, and "auto" takes it; with
+    nothing chosen "auto" keeps the series."""
+    rng = np.random.default_rng(1)
+    t = np.linspace(0, 2 * np.pi, 40)
+    y = np.arange(24) % 2
+    X = np.stack([np.where(c, np.sin(t), np.sin(2 * t)) for c in y])
+    X += rng.uniform(-10, 10, (24, 1)) + 0.05 * rng.standard_normal((24, 40))
+    auto = RTWNearestCentroid(method="dba", representation="auto").fit(X, y)
+    report = auto.selection_["representation"]
+    assert auto.representation_ == report["chosen"] == "velocity"
+    assert report["z"] >= 1.0 and report["accuracy"]["velocity"] > report["accuracy"]["raw"]
+    assert auto.means_.shape[1] == 39
+    fixed = RTWNearestCentroid(method="dba", representation="auto", n_centroids=1,
+                               dtw_window=None).fit(X, y)  # fmt: skip
+    assert fixed.representation_ == "raw" and fixed.selection_ == {}

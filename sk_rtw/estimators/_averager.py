@@ -14,7 +14,7 @@ from sklearn.utils.validation import check_is_fitted
 from .._settings import PRESETS
 from ..dtw import dtw_pairwise_distance
 from ..methods import FitContext, get_method
-from ..representations import represent, represented_manifold
+from ..representations import REPRESENTATIONS, represent, represented_manifold
 from ..utils import SeriesCollection, check_series_collection
 from ..utils._params import declare_parameters, validate_parameters
 from ._core import _label, fit_centroids
@@ -26,7 +26,7 @@ from ._params import (
     setting_hint,
 )
 from ._partition import partition
-from ._selection import choose
+from ._selection import Z_THRESHOLD, choose, mcnemar
 
 if TYPE_CHECKING:
     import torch
@@ -192,10 +192,12 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         method.check_settings()  # every setting checked before any work
         collection = check_series_collection(X, self.manifold)
         self.manifold_ = collection.manifold
-        self.representation_ = params["representation"]
         if collection.equal_length and collection.manifold.point_shape == (1,):
             self.n_features_in_ = collection.max_length
-        collection = represent(collection, self.representation_)
+        series = collection  # on the manifold, for a representation still to choose
+        representation = params["representation"]
+        if representation != "auto":
+            collection = represent(collection, representation)
         if y is None:
             labels = np.zeros(collection.n_series, dtype=int)
         else:
@@ -209,14 +211,22 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         window, n_centroids = params["dtw_window"], params["n_centroids"]
         self.selection_ = {}
         selection = None
-        if "auto" in (window, n_centroids):
-            if PRESETS[params["preset"]].chooses:
-                selection = self._select(collection, codes, window, n_centroids, params)
-                window, n_centroids = selection.dtw_window, selection.n_centroids
-                self.selection_ = selection.report
-            else:  # the paper's protocol: one mean per class, no band
-                window = None if window == "auto" else window
-                n_centroids = 1 if n_centroids == "auto" else n_centroids
+        chooses = "auto" in (window, n_centroids) and PRESETS[params["preset"]].chooses
+        if representation == "auto" and not chooses:  # nothing is chosen: the series
+            representation, collection = "raw", series
+        if chooses and representation == "auto":
+            representation, collection, selection = self._select_representation(
+                series, codes, window, n_centroids, params
+            )
+        elif chooses:
+            selection = self._select(collection, codes, window, n_centroids, params)
+        if selection is not None:
+            window, n_centroids = selection.dtw_window, selection.n_centroids
+            self.selection_ = selection.report
+        elif "auto" in (window, n_centroids):  # the paper's protocol: one mean, no band
+            window = None if window == "auto" else window
+            n_centroids = 1 if n_centroids == "auto" else n_centroids
+        self.representation_ = representation
         context = replace(context, dtw_window=window)
         config = method.configure(context)  # resolved once, with the band chosen
         owner = type(self).__name__
@@ -260,6 +270,34 @@ class RTWAverager(TransformerMixin, BaseEstimator):
             collection, codes, window, n_centroids, random_state=self.random_state,
             n_jobs=params["n_jobs"], verbose=int(params["verbose"]), owner=type(self).__name__,
         )  # fmt: skip
+
+    def _select_representation(self, series, codes, window, n_centroids, params):
+        """``representation="auto"``: the band and the centroids chosen on the series and
+        on their tangent velocity; the velocity only where its choice classifies the
+        held-out series better than the series' choice by :data:`Z_THRESHOLD` standard
+        errors (McNemar, on the series both scored). Returns the representation, the
+        collection in it and its selection (whose report says what the other scored)."""
+        choices = {}
+        for name in REPRESENTATIONS:
+            collection = represent(series, name)
+            choices[name] = (collection, self._select(collection, codes, window, n_centroids,
+                                                      params))  # fmt: skip
+        correct = {}
+        for name, (_, selection) in choices.items():
+            held_out = selection.held_out
+            right = held_out.argmin(1) == codes[selection.sample]
+            correct[name] = dict(zip(selection.sample.tolist(), right.tolist(), strict=True))
+        common = sorted(set(correct["raw"]) & set(correct["velocity"]))
+        raw = np.array([correct["raw"][i] for i in common], dtype=bool)
+        velocity = np.array([correct["velocity"][i] for i in common], dtype=bool)
+        z = float(mcnemar(velocity, raw))
+        chosen = "velocity" if z >= Z_THRESHOLD else "raw"
+        collection, selection = choices[chosen]
+        selection.report["representation"] = {
+            "chosen": chosen, "z": z, "n_series": len(common),
+            "accuracy": {"raw": float(raw.mean()), "velocity": float(velocity.mean())},
+        }  # fmt: skip
+        return chosen, collection, selection
 
     def _represented(self, X: Any) -> tuple[SeriesCollection, SeriesCollection]:
         """``X`` validated on the fitted manifold and the centroids, both in the fitted

@@ -46,11 +46,14 @@ DTW_WINDOW = replace(
 )
 REPRESENTATION = Parameter(
     "representation",
-    (Options(REPRESENTATIONS),),
+    (Options((*REPRESENTATIONS, "auto")),),
     'What is averaged and compared: "raw" the series, "velocity" their tangent velocity '
     "(sk_rtw.tangent_velocity: the manifold's derivative series, Euclidean vectors; the "
-    "centroids are then velocity series). The representation is applied to every series "
-    "the estimator is given, in fit and after.",
+    "centroids are then velocity series), applied to every series the estimator is given, "
+    'in fit and after. "auto": chosen with the band and the centroids (both chosen on the '
+    "series and on their velocity; the velocity where its choice classifies the held-out "
+    "training series better by a standard error, fitted representation_ and "
+    'selection_["representation"]); the series where nothing is chosen.',
 )
 TEMPERATURE = Parameter(
     "temperature",
