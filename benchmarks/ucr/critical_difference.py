@@ -23,6 +23,10 @@ from pathlib import Path
 
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the repository
+
+from benchmarks._shared import positive_int
+
 
 def read_accuracies(roots: list[Path], classifiers: list[str] | None, resamples: int | None):
     """``(datasets, classifiers, accuracy (n_datasets, n_classifiers))``: the mean over the
@@ -31,7 +35,15 @@ def read_accuracies(roots: list[Path], classifiers: list[str] | None, resamples:
 
     tables = {}
     for root in roots:
-        for path in sorted((root / "classification" / "accuracy").glob("*_accuracy.csv")):
+        folder = root / "classification" / "accuracy"
+        if not root.is_dir():
+            raise SystemExit(f"error: {root} is not an existing folder")
+        if not any(folder.glob("*_accuracy.csv")):
+            raise SystemExit(
+                f"error: {root} holds no accuracy summary: expected "
+                f"{folder}/<Classifier>_accuracy.csv (what run.py writes under <out>/tsml)"
+            )
+        for path in sorted(folder.glob("*_accuracy.csv")):
             name = path.name[: -len("_accuracy.csv")]
             if classifiers and name not in classifiers:
                 continue
@@ -57,7 +69,8 @@ def main(argv=None) -> int:
     )
     parser.add_argument("roots", nargs="+", type=Path, help="folders in the tsml layout")
     parser.add_argument("--classifiers", nargs="+", help="which (default: every one found)")
-    parser.add_argument("--resamples", type=int, default=None, help="first K (default all)")
+    parser.add_argument("--resamples", type=positive_int, default=None,
+                        help="first K (default all)")  # fmt: skip
     parser.add_argument("--out", type=Path, default=Path("critical_difference.png"))
     args = parser.parse_args(argv)
     datasets, names, accuracy = read_accuracies(args.roots, args.classifiers, args.resamples)

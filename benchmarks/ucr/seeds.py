@@ -169,7 +169,15 @@ def main(argv=None) -> None:
     parts = halves(names)
     for spec in args.combine:
         label, _, members = spec.partition("=")
-        parts[label] = [n for half in members.split("+") for n in parts.get(half, [])]
+        halves_named = members.split("+")
+        unknown = [half for half in halves_named if half not in parts]
+        if not label or not members or unknown:
+            parser.error(
+                f"argument --combine: {spec!r} must be NAME=H1+H2 with halves the results "
+                f"hold ({', '.join(parts)})"
+                + (f"; not there: {', '.join(unknown)}" if label and members else "")
+            )
+        parts[label] = [n for half in halves_named for n in parts[half]]
     seeds = ", ".join(str(s) for s in sorted(records))
     table = {label: dict(rows(records, found)) for label, found in parts.items() if found}
     labels = list(next(iter(table.values())))

@@ -10,6 +10,7 @@ import numpy as np
 from aeon.classification.base import BaseClassifier
 from aeon.utils.validation import check_n_jobs
 
+from .._numba import check_n_jobs as check_n_jobs_value
 from ..manifolds import SPD, Euclidean
 from ..utils import from_aeon
 
@@ -69,6 +70,7 @@ class DelegatingClassifier(BaseClassifier):
         return self.manifold
 
     def _fit(self, X: np.ndarray | list[np.ndarray], y: np.ndarray) -> DelegatingClassifier:
+        check_n_jobs_value(self.n_jobs)  # 0 refused, as the wrapped estimator refuses it
         self._n_jobs = check_n_jobs(self.n_jobs if self.n_jobs is not None else 1)
         names = self._wrapped._declaration.names  # type: ignore[attr-defined]
         params = {name: getattr(self, name) for name in names if name != "n_jobs"}

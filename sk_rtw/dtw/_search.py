@@ -317,8 +317,10 @@ def dtw_nearest_distance(
     Lower bounds (LB_Keogh) skip the series of ``Y`` that cannot be nearer than the
     best distance so far, and the exact DTWs stop early once they cannot (module
     docstring of :mod:`sk_rtw.dtw._search`); the values are those of the exhaustive
-    search, bit for bit. Manifolds whose point distances have no compiled form (SPD,
-    yours) take the exhaustive search.
+    search, bit for bit. Every shipped manifold is searched so (SPD matrices by the
+    bound of their sorted log-eigenvalues, up to 12 x 12); manifolds whose point
+    distances have no compiled form (yours, larger SPD matrices) take the exhaustive
+    search.
 
     Parameters
     ----------
@@ -389,8 +391,15 @@ def _nearest(X, Y, groups, manifold, window, squared, exclude, exclude_group, ma
                           lowest=-1)  # fmt: skip
     if n and skip.max() >= m:
         raise ValueError(f"exclude holds {skip.max()}, but Y has {m} series")
-    limits = np.broadcast_to(np.inf if max_distance is None else max_distance, (n,))
-    limits = np.ascontiguousarray(limits, dtype=np.float64)
+    limit = np.asarray(np.inf if max_distance is None else max_distance)
+    if limit.ndim > 1 or (limit.ndim == 1 and limit.shape != (n,)):
+        raise ValueError(
+            f"max_distance must be a number or {n} numbers, one per series of X; got shape "
+            f"{limit.shape}"
+        )
+    if limit.dtype.kind not in "biuf":
+        raise TypeError(f"max_distance must be numeric, got {limit.dtype}")
+    limits = np.ascontiguousarray(np.broadcast_to(limit, (n,)), dtype=np.float64)
     if np.isnan(limits).any():
         raise ValueError("max_distance must not be NaN")
     segments = _point_costs.segment_codes(cx.manifold)
