@@ -76,3 +76,30 @@ def test_the_aeon_classifiers_refuse_zero_jobs_as_sk_rtw_does():
     for cls in (RTWClassifier, RTWProximityForestClassifier):
         with pytest.raises(ValueError, match="n_jobs must not be 0"):
             cls(n_jobs=0).fit(X, y)
+
+
+def test_prototype_classifier_says_how_many_folds_it_used():
+    from sk_rtw import RTWPrototypeClassifier
+
+    from .test_estimators import two_shape_classes
+
+    X, y = two_shape_classes(n_per_class=4)
+    with pytest.warns(UserWarning, match="4 folds are used"):
+        proto = RTWPrototypeClassifier(method="dba", cv=10).fit(X, y)
+    assert proto.n_folds_ == 4
+
+
+def test_prototype_probabilities_say_why_the_readout_has_none():
+    from sk_rtw import RTWPrototypeClassifier
+
+    from .test_estimators import two_shape_classes
+
+    X, y = two_shape_classes()
+    proto = RTWPrototypeClassifier(method="dba", decision="readout", cv=2).fit(X, y)
+    with pytest.raises(AttributeError) as raised:
+        proto.predict_proba(X)
+    # scikit-learn's available_if raises its own message from ours, shown above it
+    assert "LogisticRegression" in str(raised.value.__cause__)
+    assert not hasattr(proto, "predict_proba")
+    nearest = RTWPrototypeClassifier(method="dba", decision="nearest", cv=2).fit(X, y)
+    assert nearest.predict_proba(X).shape == (len(X), 2)

@@ -119,16 +119,24 @@ def out_of_fold_distances(
     return _fill_unseen(distances, codes)
 
 
+def fold_count(n_folds: int, codes: np.ndarray) -> int:
+    """The folds :func:`split_folds` makes of ``n_folds`` asked: at most as many as the
+    largest class has series (as many as there are series where every class holds
+    one)."""
+    largest = int(np.bincount(codes).max())
+    return min(n_folds, len(codes) if largest < 2 else largest)
+
+
 def split_folds(n_folds: int, codes: np.ndarray, seed: int) -> list[tuple[np.ndarray, np.ndarray]]:
     """Stratified (train, test) folds, at most as many as the largest class has series
-    (plain folds where every class holds one series); a class smaller than the folds is
-    missing from some of them."""
-    largest = int(np.bincount(codes).max())
+    (plain folds where every class holds one series; :func:`fold_count`); a class
+    smaller than the folds is missing from some of them."""
+    count = fold_count(n_folds, codes)
     splitter: KFold | StratifiedKFold
-    if largest < 2:
-        splitter = KFold(min(n_folds, len(codes)), shuffle=True, random_state=seed)
+    if int(np.bincount(codes).max()) < 2:
+        splitter = KFold(count, shuffle=True, random_state=seed)
     else:
-        splitter = StratifiedKFold(min(n_folds, largest), shuffle=True, random_state=seed)
+        splitter = StratifiedKFold(count, shuffle=True, random_state=seed)
     with warnings.catch_warnings():
         warnings.filterwarnings("ignore", "The least populated class", UserWarning)
         return list(splitter.split(np.zeros(len(codes)), codes))

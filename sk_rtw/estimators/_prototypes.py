@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import warnings
 from numbers import Integral
 from typing import TYPE_CHECKING, Any
 
@@ -18,7 +19,7 @@ from ..utils._constraints import Constant, Interval, Options, Satisfies
 from ..utils._params import Parameter, declare_parameters, validate_parameters
 from ._averager import _check_labels, _encode
 from ._classifier import RTWNearestCentroid, fit_temperature
-from ._out_of_fold import out_of_fold_distances
+from ._out_of_fold import fold_count, out_of_fold_distances
 from ._params import (
     AVERAGER_DEFAULTS,
     AVERAGER_PARAMETERS,
@@ -98,7 +99,15 @@ def _readout_has(name: str):
         readout = getattr(self, "readout_", None)
         if readout is None:
             readout = default_readout() if self.readout is None else self.readout
-        return hasattr(readout, name)
+        if not hasattr(readout, name):
+            final = readout[-1] if isinstance(readout, Pipeline) else readout
+            raise AttributeError(
+                f"{type(self).__name__} has no {name} here: its readout "
+                f"({type(final).__name__}) has none, and the fitted decision is the "
+                "readout's. Pass a readout that has it, e.g. readout=LogisticRegression(), "
+                'or decision="nearest" (the nearest centroid\'s softmax)'
+            )
+        return True
 
     return check
 
@@ -174,6 +183,9 @@ class RTWPrototypeClassifier(ClassifierMixin, TransformerMixin, BaseEstimator):
         Centroids of every class (as ``RTWNearestCentroid.n_centroids_``).
     decision_ : {"readout", "nearest"}
         What classifies: the readout, or the nearest centroid (``decision``).
+    n_folds_ : int
+        The folds of the out-of-fold distances: ``cv``, or fewer where the largest class
+        has fewer series (a warning says so).
     cv_accuracy_ : dict
         Behind ``decision="auto"`` (empty otherwise): ``"readout"`` (its cross-validated
         accuracy on the out-of-fold distances), ``"nearest"`` (the nearest out-of-fold
@@ -284,6 +296,13 @@ class RTWPrototypeClassifier(ClassifierMixin, TransformerMixin, BaseEstimator):
         centroids.fit(X, y)
         collection, _ = centroids._represented(X)
         _, codes = _encode(_check_labels(y, collection.n_series, True))
+        self.n_folds_ = fold_count(params["cv"], codes)
+        if self.n_folds_ < params["cv"]:
+            warnings.warn(
+                f"{type(self).__name__}: cv={params['cv']} asks for more folds than the "
+                f"largest class has series; {self.n_folds_} folds are used (n_folds_)",
+                UserWarning, stacklevel=2,
+            )  # fmt: skip
         distances = out_of_fold_distances(
             centroids, collection, codes, params["cv"], random_state=seed,
             owner=type(self).__name__,
