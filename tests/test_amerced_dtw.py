@@ -108,3 +108,19 @@ def test_path_normalisation_is_refused_with_a_penalty():
     with pytest.raises(ValueError, match="amerced"):
         dtw_distance(np.zeros(5), np.ones(5), normalize="path", warp_penalty=1.0)
     assert dtw_distance(np.zeros(5), np.ones(5), normalize="path", warp_penalty=0.0) == 1.0
+
+
+@pytest.mark.parametrize("penalty", [0.05, 0.5, 3.0])
+def test_the_search_narrows_amerced_dtw_to_its_bound_without_changing_the_answer(penalty, rng):
+    """Equal lengths and no band: a path d columns off the diagonal costs at least
+    2 d penalty, so the search computes the band that the best distance so far allows;
+    the distances (and the nearest group) are the exhaustive ones."""
+    X = np.cumsum(rng.standard_normal((12, 60)), axis=1)
+    Y = np.cumsum(rng.standard_normal((25, 60)), axis=1)
+    groups = np.arange(25) % 5
+    full = dtw_pairwise_distance(X, Y, warp_penalty=penalty)
+    expected = np.stack([full[:, groups == g].min(1) for g in range(5)], axis=1)
+    got = dtw_nearest_distance(X, Y, groups, warp_penalty=penalty)
+    np.testing.assert_allclose(got, expected, rtol=1e-12)
+    nearest = dtw_nearest_distance(X, Y, groups, warp_penalty=penalty, nearest_only=True)
+    assert np.array_equal(nearest.argmin(1), expected.argmin(1))

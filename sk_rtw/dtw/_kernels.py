@@ -93,15 +93,8 @@ def _band_row(cost_row, prev, cur, lo, hi, penalty):
     costs its band's width, not the series' length.
     """
     cur[lo] = _INF
-    _recurrence(cost_row, prev, cur, lo, hi, _INF, penalty)
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _recurrence(cost_row, prev, cur, lo, hi, left, penalty):
-    """The recursion over columns ``[lo, hi)`` of a row into ``cur`` (padded), ``left``
-    the cell before column ``lo``; returns the last cell computed. Two loops: a test of
-    ``penalty`` per cell would slow plain DTW by 40 %."""
-    if penalty == 0.0:
+    left = _INF
+    if penalty == 0.0:  # two loops: a test per cell would slow plain DTW by 40 %
         for j in range(lo, hi):
             left = _cell(prev, left, j, cost_row[j])
             cur[j + 1] = left
@@ -109,7 +102,6 @@ def _recurrence(cost_row, prev, cur, lo, hi, left, penalty):
         for j in range(lo, hi):
             left = _amerced_cell(prev, left, j, cost_row[j], penalty)
             cur[j + 1] = left
-    return left
 
 
 @njit(cache=True, nogil=True)

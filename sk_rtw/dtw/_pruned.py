@@ -15,15 +15,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from ._kernels import (
-    _amerced_cell,
-    _band_row,
-    _cell,
-    _recurrence,
-    _two_rows,
-    choose_step,
-    sakoe_chiba_rows,
-)
+from ._kernels import _amerced_cell, _band_row, _cell, _two_rows, choose_step, sakoe_chiba_rows
 from ._point_costs import _cost_row, _roots
 
 _INF = np.inf
@@ -56,22 +48,9 @@ def _pruned_row(x, y, i, prev, cur, costs, lo, hi, reach, bound, segments, squar
             _roots(costs[lo:hi], hi - lo)
         _band_row(costs, prev, cur, lo, hi, penalty)
         return lo, hi - 1, hi - 1
-    first, last = -1, -1
-    # before ``reach`` no cell ends the row: the plain recursion, then a scan for the kept
-    # cells (checks inside the recursion's chain of dependencies cost twice the cells)
-    before = min(hi, max(lo, reach))
     left = _INF
-    if before > lo:
-        _cost_row(x, y[lo:before], i, before - lo, segments, squared, costs[lo:before])
-        if root:
-            _roots(costs[lo:before], before - lo)
-        left = _recurrence(costs, prev, cur, lo, before, _INF, penalty)
-        for j in range(lo, before):
-            if cur[j + 1] <= bound:
-                if first < 0:
-                    first = j
-                last = j
-    for chunk in range(before, hi, PRUNE_CHUNK):
+    first, last = -1, -1
+    for chunk in range(lo, hi, PRUNE_CHUNK):
         stop = min(hi, chunk + PRUNE_CHUNK)
         _cost_row(x, y[chunk:stop], i, stop - chunk, segments, squared, costs[chunk:stop])
         if root:
@@ -82,11 +61,12 @@ def _pruned_row(x, y, i, prev, cur, costs, lo, hi, reach, bound, segments, squar
             else:
                 left = _amerced_cell(prev, left, j, costs[j], penalty)
             cur[j + 1] = left
-            if left > bound:  # past ``reach``: every cell to its right exceeds it too
+            if left <= bound:
+                if first < 0:
+                    first = j
+                last = j
+            elif j >= reach:
                 return first, last, j
-            if first < 0:
-                first = j
-            last = j
     return first, last, hi - 1
 
 
@@ -109,7 +89,7 @@ def accumulated_segment_cost(x, y, segments, squared, window, bound):
     in ``values[offsets[i]:offsets[i + 1]]`` (:func:`ragged_value` reads a cell).
     """
     lo, hi = sakoe_chiba_rows(x.shape[0], y.shape[0], window)
-    return _pruned_rows(x, y, segments, squared, lo, hi, bound, True, 0.0, False, None)[:3]
+    return _pruned_rows(x, y, segments, squared, lo, hi, bound, True, 0.0, False)[:3]
 
 
 @njit(cache=True, nogil=True)
@@ -118,7 +98,7 @@ def band_segment_cost(x, y, segments, squared, lo, hi):
     ``lo[i] <= j < hi[i]`` (``lo`` and ``hi`` non-decreasing, ``lo[0] = 0``,
     ``hi[-1] = len(y)``), every cell of it computed; the same ``(values, offsets,
     starts)`` rows."""
-    return _pruned_rows(x, y, segments, squared, lo, hi, _INF, True, 0.0, False, None)[:3]
+    return _pruned_rows(x, y, segments, squared, lo, hi, _INF, True, 0.0, False)[:3]
 
 
 @njit(cache=True, nogil=True)
@@ -141,15 +121,12 @@ def band_accumulated_cost(costs, lo, hi):
 
 
 @njit(cache=True, nogil=True)
-def pruned_distance(x, y, segments, squared, window, bound, penalty=0.0, root=False,
-                    tails=None):  # fmt: skip
+def pruned_distance(x, y, segments, squared, window, bound, penalty=0.0, root=False):
     """The DTW distance of flattened series ``x`` and ``y`` in two rows of memory, the
     cells that cannot beat ``bound`` skipped as in :func:`accumulated_segment_cost`:
     exact when at most ``bound``, otherwise some value above it (``inf`` if the bound
     was too low). ``penalty``: amerced DTW's, on every step off the diagonal (0: DTW);
-    ``root``: point costs are the square roots of the distances; ``tails[i]``: a lower
-    bound of the cost of the rows after row ``i`` (:func:`~._search.row_tails`), which
-    skips the cells that cannot beat ``bound`` earlier (the same value)."""
+    ``root``: point costs are the square roots of the distances."""
     if bound == _INF:  # the plain recursion, without the pruning's bookkeeping per row
         lo, hi = sakoe_chiba_rows(x.shape[0], y.shape[0], window)
         prev, cur = _two_rows(y.shape[0])
@@ -163,15 +140,14 @@ def pruned_distance(x, y, segments, squared, window, bound, penalty=0.0, root=Fa
             prev, cur = cur, prev
         return prev[y.shape[0]]
     lo, hi = sakoe_chiba_rows(x.shape[0], y.shape[0], window)
-    return _pruned_rows(x, y, segments, squared, lo, hi, bound, False, penalty, root, tails)[3]
+    return _pruned_rows(x, y, segments, squared, lo, hi, bound, False, penalty, root)[3]
 
 
 @njit(cache=True, nogil=True)
-def _pruned_rows(x, y, segments, squared, lo, hi, bound, store, penalty, root, tails):
+def _pruned_rows(x, y, segments, squared, lo, hi, bound, store, penalty, root):
     """Rows of the accumulated cost in two buffers, each kept in ``values`` if ``store``:
     ``(values, offsets, starts, last cell)`` (see :func:`accumulated_segment_cost`), in
-    the staircase band ``[lo[i], hi[i])``, off-diagonal steps amerced by ``penalty``;
-    with ``tails`` (or None), row ``i`` keeps the cells within ``bound - tails[i]``."""
+    the staircase band ``[lo[i], hi[i])``, off-diagonal steps amerced by ``penalty``."""
     nx, ny = x.shape[0], y.shape[0]
     prev, cur = _two_rows(ny)
     costs = np.empty(ny)
@@ -184,11 +160,9 @@ def _pruned_rows(x, y, segments, squared, lo, hi, bound, store, penalty, root, t
     for i in range(nx):
         a = max(lo[i], start)
         cur[a] = _INF  # column a - 1, which the next row reads and this one does not write
-        row_bound = bound if tails is None else bound - tails[i]
         first, last, written = _pruned_row(
-            x, y, i, prev, cur, costs, a, hi[i], reach, row_bound, segments, squared, penalty,
-            root,
-        )  # fmt: skip
+            x, y, i, prev, cur, costs, a, hi[i], reach, bound, segments, squared, penalty, root
+        )
         for k in range(written + 2, cur_end + 1):  # what two rows ago left further right
             cur[k] = _INF
         cur_end = max(written + 1, a)
