@@ -130,20 +130,20 @@ def _store(out, i, a, b, c):  # pragma: no cover
 @njit(inline="always", **_OPTIONS)
 def _log_terms(P, X, i):  # pragma: no cover
     """What ``Log`` and the distance of pair ``i`` share: the entries (``xb`` deflated),
-    ``m``, ``q``, ``delta``, ``log(delta)``, ``B`` and ``B_q``."""
+    ``m``, ``q``, ``delta``, ``log(delta)``, ``B`` and ``B_q``, in one flat tuple (numba's
+    parallel array analysis fails on a nested one unpacked inside a ``prange`` loop)."""
     pa, pb, pc = _entries(P, i)
     xa, xb, xc = _entries(X, i)
     m, q, xb, det_p = _congruence(pa, pb, pc, xa, xb, xc)
     delta = (xa * xc - xb * xb) / det_p
     log_det = math.log(delta)
     slope, slope_q = _log_slope(m, q, log_det, delta)
-    return (pa, pb, pc, xa, xb, xc), m, q, delta, log_det, slope, slope_q
+    return pa, pb, pc, xa, xb, xc, m, q, delta, log_det, slope, slope_q
 
 
 def _log_rows(P, X, out, saved, save):  # pragma: no cover
     for i in prange(P.shape[0]):
-        entries, m, _, delta, log_det, slope, slope_q = _log_terms(P, X, i)
-        pa, pb, pc, xa, xb, xc = entries
+        pa, pb, pc, xa, xb, xc, m, _, delta, log_det, slope, slope_q = _log_terms(P, X, i)
         a = 0.5 * log_det - slope * m
         _store(out, i, a * pa + slope * xa, a * pb + slope * xb, a * pc + slope * xc)
         if save:
@@ -168,7 +168,7 @@ def _exp_rows(P, V, out, saved, save):  # pragma: no cover
 def _dist_rows(P, X, out, saved, save):  # pragma: no cover
     """The distance; ``saved`` holds ``(d^2 / dm, d^2 / ddelta, m, delta, 1 / (2 d))``."""
     for i in prange(P.shape[0]):
-        _, m, q, delta, log_det, slope, slope_q = _log_terms(P, X, i)
+        _, _, _, _, _, _, m, q, delta, log_det, slope, slope_q = _log_terms(P, X, i)
         x = q / (m * m)
         if x < _SERIES_BELOW:
             ratio2 = x * (1.0 + x * (2.0 / 3.0 + x * 23.0 / 45.0))  # atanh(sqrt(x))^2
