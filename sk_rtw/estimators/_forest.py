@@ -84,12 +84,12 @@ class RTWProximityForest(ClassifierMixin, BaseEstimator):
     series of the node to the branch of its nearest exemplar. The measure draws, as
     Proximity Forest 2.0 (Herrmann et al. 2023) draws its DTW family: the representation
     (the series, or their tangent velocity: the manifold's derivative series,
-    :func:`sk_rtw.tangent_velocity`), the point cost (geodesic distance or its square),
-    and either DTW in a Sakoe-Chiba band of radius up to a quarter of the length, or
-    amerced DTW without a band (a penalty on every step off the diagonal, drawn on a
-    scale taken from the node's series). Trees split until their leaves are pure;
-    ``predict_proba`` averages the class proportions of the leaves the series reach in
-    every tree (with pure leaves: the trees' vote). The nearest exemplar is found by the
+    :func:`sk_rtw.tangent_velocity`), the point cost (the geodesic distance to the power
+    1/2, 1 or 2), and either DTW in a Sakoe-Chiba band of radius up to a quarter of the
+    length, or amerced DTW without a band (a penalty on every step off the diagonal,
+    drawn on a scale taken from the node's series). Trees split until their leaves are
+    pure; ``predict_proba`` averages the class proportions of the leaves the series
+    reach in every tree (with pure leaves: the trees' vote). The nearest exemplar is found by the
     package's nearest search (lower bounds, early abandoning, the exhaustive answer).
 
     When to pick it: it is the most accurate classifier of the package where classes
