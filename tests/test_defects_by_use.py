@@ -103,3 +103,21 @@ def test_prototype_probabilities_say_why_the_readout_has_none():
     assert not hasattr(proto, "predict_proba")
     nearest = RTWPrototypeClassifier(method="dba", decision="nearest", cv=2).fit(X, y)
     assert nearest.predict_proba(X).shape == (len(X), 2)
+
+
+@pytest.mark.parametrize("k", [2, 3])
+def test_spd_maps_refuse_a_tangent_vector_that_is_not_symmetric(k):
+    """exp and norm used the symmetric part of a non-symmetric vector without a word;
+    symmetric vectors (within 1e-6 of their largest entry) are still accepted."""
+    from sk_rtw import SPD
+
+    space, P = SPD(k), np.eye(k)
+    V = np.zeros((k, k))
+    V[0, 0], V[0, 1] = 0.1, 0.4
+    for method in (space.exp, space.norm):
+        with pytest.raises(ValueError, match=r"v is not a tangent vector of SPD.*not symmetric"):
+            method(P, V)
+    symmetric = V + V.T
+    symmetric[0, 1] += 1e-9
+    expected = space.exp(P, (symmetric + symmetric.T) / 2)
+    np.testing.assert_allclose(space.exp(P, symmetric), expected, rtol=1e-8)

@@ -30,15 +30,16 @@ EXTREME_EXPONENT = 100
 DISTANCE_KINDS = ("euclidean", "sphere", "sign-invariant sphere", "spd")
 
 
-def checked_geometry(points=(), vectors=(), broadcast=True):
+def checked_geometry(points=(), vectors=(), plain=(), broadcast=True):
     """:func:`numpy_compatible`, plus argument checks for numpy (public) calls.
 
     Arrays named in ``points`` must be finite points of the manifold, those in
-    ``vectors`` finite arrays of points' shape, and all of them broadcast against each
-    other (unless ``broadcast=False``, as for ``pairwise_dist``). Torch tensors -- the
-    engine's internal calls -- are not checked.
+    ``vectors`` finite tangent vectors (:meth:`Manifold._vector_problem`), those in
+    ``plain`` finite arrays of points' shape (``project``'s input), and all of them
+    broadcast against each other (unless ``broadcast=False``, as for ``pairwise_dist``).
+    Torch tensors -- the engine's internal calls -- are not checked.
     """
-    names = (*points, *vectors)
+    names = (*points, *vectors, *plain)
 
     def decorate(method):
         wrapped = numpy_compatible(method)
@@ -47,7 +48,7 @@ def checked_geometry(points=(), vectors=(), broadcast=True):
         def wrapper(self, *arrays, **kwargs):
             if not any(isinstance(a, torch.Tensor) for a in arrays):
                 checked = [
-                    self._check_argument(a, name, name in points)
+                    self._check_argument(a, name, name in points, name in vectors)
                     for a, name in zip(arrays, names, strict=False)
                 ]
                 if broadcast and len(checked) > 1:
@@ -371,7 +372,7 @@ class Manifold(ABC):
         nd = self.point_ndim
         return self._dist(A.unsqueeze(-nd - 1), B.unsqueeze(-nd - 2))
 
-    @checked_geometry(vectors=("X",))
+    @checked_geometry(plain=("X",))
     def project(self, X):
         """Nearest point on the manifold (normalise, symmetrise, clip eigenvalues, ...).
 
@@ -480,7 +481,9 @@ class Manifold(ABC):
                     "onto the manifold."
                 )
 
-    def _check_argument(self, value: Any, name: str, is_point: bool) -> np.ndarray:
+    def _check_argument(
+        self, value: Any, name: str, is_point: bool, is_vector: bool = False
+    ) -> np.ndarray:
         try:
             arr = np.asarray(value, dtype=np.float64)
         except (TypeError, ValueError):
@@ -496,7 +499,17 @@ class Manifold(ABC):
             self.validate(arr, name=name)
         elif not np.all(np.isfinite(arr)):
             raise ValueError(f"{name} contains NaN or infinite values")
+        elif is_vector:
+            problem = self._vector_problem(arr)
+            if problem is not None:
+                raise ValueError(f"{name} is not a tangent vector of {self!r}: {problem}")
         return arr
+
+    def _vector_problem(self, v: np.ndarray) -> str | None:
+        """What makes the finite array ``v`` (``(..., *point_shape)``) no tangent vector of
+        this space at any point, or None (the default: every array of the points' shape
+        is one, as in R^d; SPD(k) needs symmetric matrices)."""
+        return None
 
     def extreme_scale(self, points: np.ndarray) -> float | None:
         """A power of two to divide ``points`` by when their magnitude is extreme, or None.

@@ -154,6 +154,21 @@ class SPD(Manifold):
         floor = (w.abs().amax(-1, keepdim=True) * 1e-10).clamp_min(1e-12)
         return sym((U * w.clamp_min(floor).unsqueeze(-2)) @ U.mT)
 
+    def _vector_problem(self, v):
+        # the tangent space is the symmetric matrices: exp and norm would otherwise use the
+        # symmetric part of v silently
+        scale = np.maximum(np.abs(v).max(axis=(-2, -1)), 1.0)
+        asymmetry = np.abs(v - np.swapaxes(v, -1, -2)).max(axis=(-2, -1)) / scale
+        if np.all(asymmetry <= 1e-6):
+            return None
+        index = np.unravel_index(int(np.argmax(asymmetry)), asymmetry.shape)
+        where = f" (at index {index})" if index else ""
+        return (
+            f"the matrix is not symmetric{where}: its entries differ from their transpose's "
+            f"by {float(asymmetry.max()):.3g} relative to its largest entry (tolerance 1e-6); "
+            "tangent vectors of SPD(k) are symmetric matrices"
+        )
+
     def _point_problems(self, x, atol):
         scale = x.abs().amax(dim=(-2, -1)).clamp_min(1.0)
         asymmetry = (x - x.mT).abs().amax(dim=(-2, -1)) / scale
