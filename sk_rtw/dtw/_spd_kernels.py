@@ -14,7 +14,8 @@ cancellation); the smaller of two comes from the determinant (``det M = det B / 
 known from the log-eigenvalues), the smallest of three as the inverse of the largest of
 the reverse pair ``(A, B)`` and the middle one from the determinant. Larger pairs (``k``
 from 4 to ``MAX_KERNEL_SIZE``) take the eigenvalues of the same congruence from a
-Householder reduction and the implicit QL iteration, compiled, one pair at a time.
+Householder reduction and the implicit QL iteration, compiled, one pair at a time, for
+the pair and its reverse (the small eigenvalues from the reverse pair's large ones).
 
 The sorted log-eigenvalues are also a lower bound: ``||log lambda(A) - log lambda(B)||``
 is at most ``dist(A, B)`` (the sorted log-spectrum is 1-Lipschitz for the
@@ -127,6 +128,7 @@ def spd_features(points, k):
     out = np.empty((n, k * (k + 2)))
     if k > 3:
         _general_features(points, k, out)
+        _diagonal_log_eigenvalues(points, k, out)
         return out
     for t in range(n):
         x = points[t]
@@ -168,7 +170,29 @@ def spd_features(points, k):
             log_det = 2.0 * (math.log(l11) + math.log(l22) + math.log(l33))
             f[1] = log_det - f[0] - f[2]
             f[9], f[10], f[11], f[12], f[13], f[14] = a11, a12, a13, a22, a23, a33
+    _diagonal_log_eigenvalues(points, k, out)
     return out
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _diagonal_log_eigenvalues(points, k, out):
+    """The log-eigenvalues of diagonal points from their entries, sorted: exact at any
+    spread (the formulas above square the entries, which overflows beyond 1e+-154)."""
+    logs = np.empty(k)
+    for t in range(points.shape[0]):
+        diagonal = True
+        for i in range(k):
+            for j in range(k):
+                if i != j and points[t, i * k + j] != 0.0:
+                    diagonal = False
+        if not diagonal:
+            continue
+        for i in range(k):
+            value = points[t, i * k + i]
+            logs[i] = math.log(value) if value > 0.0 else np.nan
+        logs.sort()
+        for i in range(k):
+            out[t, i] = logs[i]
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -219,6 +243,9 @@ def spd_log_eigenvalues3(x, y, s):
 @njit(cache=True, nogil=True, inline="always")
 def spd_squared_distance(x, y, s, k):
     """Squared affine-invariant distance of the SPD(k) points whose features start at ``s``."""
+    diagonal = _diagonal_squared_distance(x, y, s, k)
+    if diagonal >= 0.0:
+        return diagonal
     if k == 2:
         u, v = spd_log_eigenvalues2(x, y, s)
         return u * u + v * v
@@ -226,6 +253,29 @@ def spd_squared_distance(x, y, s, k):
         u, v, w = spd_log_eigenvalues3(x, y, s)
         return u * u + v * v + w * w
     return _general_squared_distance(x, y, s, k)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _diagonal_squared_distance(x, y, s, k):
+    """``sum (log y_ii - log x_ii)^2`` where both points are diagonal, else -1: the
+    log-ratios of their entries without the ratios, which over- or underflow (and the
+    congruence's products with them) for entries beyond 1e+-77; the same value as the
+    other routes elsewhere."""
+    point = s + k + k * (k + 1) // 2
+    index = point
+    for i in range(k):
+        for _ in range(i + 1, k):
+            index += 1
+            if x[index] != 0.0 or y[index] != 0.0:
+                return -1.0
+        index += 1
+    total = 0.0
+    index = point
+    for i in range(k):
+        gap = math.log(y[index]) - math.log(x[index])
+        total += gap * gap
+        index += k - i
+    return total
 
 
 # ---------------------------------------------------------------- k = 4 .. MAX_KERNEL_SIZE
@@ -280,15 +330,48 @@ def _general_features(points, k, out):
 
 @njit(cache=True, nogil=True, error_model="numpy")
 def _general_squared_distance(x, y, s, k):
-    """``sum log(lambda)^2`` over the eigenvalues of ``L^-1 B L^-T`` (lower triangle
-    formed, then :func:`_symmetric_eigenvalues`)."""
+    """``sum log(lambda)^2`` over the generalized eigenvalues of ``(B, A)``, each from the
+    side that holds it accurately: the eigenvalues of ``L_A^-1 B L_A^-T`` carry absolute
+    errors of about ``eps`` times the largest, so only its large ones are accurate; the
+    reverse pair's (``L_B^-1 A L_B^-T``, the inverses) give the small ones. Each
+    log-eigenvalue is taken from the side where it lies on the large half of the
+    log-spectrum (the middle from the two accurate ends), as 2 x 2 and 3 x 3 take the
+    smallest from the reverse pair."""
+    work = np.empty(3 * k * k + 4 * k)  # one allocation per pair
+    forward, reverse = work[3 * k * k + 2 * k : 3 * k * k + 3 * k], work[3 * k * k + 3 * k :]
+    _congruence_eigenvalues(x, y, s, k, work, forward)
+    _congruence_eigenvalues(y, x, s, k, work, reverse)
+    forward.sort()
+    reverse.sort()
+    # log lambda_i from the forward side, or -log of the reverse side's (k - 1 - i)-th
+    middle = 0.5 * (_safe_log(forward[k - 1]) - _safe_log(reverse[k - 1]))
+    total = 0.0
+    for i in range(k):
+        value = _safe_log(forward[i])
+        if value < middle:
+            value = -_safe_log(reverse[k - 1 - i])
+        total += value * value
+    return total
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _safe_log(value):
+    """``log(value)``, -inf at or below 0 (an eigenvalue lost to rounding: the other side
+    holds it)."""
+    return math.log(value) if value > 0.0 else -np.inf
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _congruence_eigenvalues(x, y, s, k, work, out):
+    """The eigenvalues (unordered) of ``L^-1 B L^-T`` into ``out``, ``L^-1`` from the
+    features of ``x`` and ``B`` from those of ``y`` (lower triangle formed, then
+    :func:`_symmetric_eigenvalues`); ``work`` holds at least ``3 k^2 + 2 k`` numbers."""
     inverse = s + k
     point = inverse + k * (k + 1) // 2
-    work = np.empty(3 * k * k + 2 * k)  # one allocation per pair
     B = work[: k * k].reshape(k, k)
     N = work[k * k : 2 * k * k].reshape(k, k)  # L^-1 B, row by row
     M = work[2 * k * k : 3 * k * k].reshape(k, k)  # the lower triangle of N L^-T
-    diagonal, off = work[3 * k * k : 3 * k * k + k], work[3 * k * k + k :]
+    off = work[3 * k * k : 3 * k * k + k]
     index = point
     for i in range(k):
         for j in range(i, k):
@@ -309,12 +392,7 @@ def _general_squared_distance(x, y, s, k):
             for m in range(j + 1):
                 total += N[i, m] * x[row + m]
             M[i, j] = total
-    _symmetric_eigenvalues(M, k, diagonal, off)
-    total = 0.0
-    for i in range(k):
-        value = math.log(diagonal[i])
-        total += value * value
-    return total
+    _symmetric_eigenvalues(M, k, out, off)
 
 
 @njit(cache=True, nogil=True, error_model="numpy")

@@ -28,7 +28,11 @@ class SPD(Manifold):
     ``dist(P, X) = ||logm(P^-½ X P^-½)||_F``. For ``k = 2`` all three are closed forms in
     the two eigenvalues of ``P^-1 X`` (no eigendecomposition); for larger ``k`` every
     matrix function goes through one symmetric eigendecomposition (shared by ``P^½`` and
-    ``P^-½``, once per distinct tangent point) and distances through eigenvalues only.
+    ``P^-½``, once per distinct tangent point) and distances through eigenvalues only:
+    those of ``L^-1 X L^-T`` (``P = L L^T``) and of the reverse pair, each log-eigenvalue
+    from the side that holds it to full relative accuracy (float64's whitened matrix
+    loses its small eigenvalues: two points of condition 1e10 gave NaN). Pairs of
+    diagonal points take the maps and the distance entry by entry, exact at any spread.
     Gradients stay finite for repeated eigenvalues (``P = X``).
 
     Parameters
@@ -97,6 +101,12 @@ class SPD(Manifold):
         return s.expand_as(p), si.expand_as(p)
 
     def _group_log(self, means, codes, points):
+        general = self._general_group_log(means, codes, points)
+        expanded = group_expand(means, codes)
+        diagonal = (_is_diagonal(expanded) & _is_diagonal(points))[..., None, None]
+        return torch.where(diagonal, _diagonal_log(expanded, points), general)
+
+    def _general_group_log(self, means, codes, points):
         if self.dim == 2 and _spd2.compiled(means, points):  # one compiled pass
             return _spd2.log(group_expand(means, codes), points)
         if self.dim == 2:  # each mean's chart once, not once per member
@@ -106,35 +116,52 @@ class SPD(Manifold):
         s, si = group_expand(s, codes), group_expand(si, codes)
         return sym(s @ symmetric_function(si @ points @ si, "log") @ s)
 
+    # Pairs of diagonal points (a diagonal point and a diagonal vector for exp) take the
+    # maps and the distance entry by entry, exact at any spread: the closed forms and the
+    # whitening lose the small entries beside large ones (to cancellation, or to ratios
+    # that over- or underflow beyond 1e+-154). The general route gets the identity there,
+    # so that no NaN of it reaches the gradient through where().
     def _exp(self, p, v):
+        return self._diagonal_aware(p, v, self._general_exp, _diagonal_exp, matrix=True)
+
+    def _log(self, p, x):
+        return self._diagonal_aware(p, x, self._general_log, _diagonal_log, matrix=True)
+
+    def _dist(self, p, x):
+        return self._diagonal_aware(p, x, self._general_dist, _diagonal_dist, matrix=False)
+
+    def _diagonal_aware(self, p, x, general, exact, matrix):
+        diagonal = _is_diagonal(p) & _is_diagonal(x)
+        if diagonal.device.type == "cpu" and not bool(diagonal.any()):
+            return general(p, x)  # the usual case, at its own speed (no sync on a GPU)
+        eye = torch.eye(self.dim, dtype=p.dtype, device=p.device)
+        mask = diagonal[..., None, None]
+        out = general(torch.where(mask, eye, p), torch.where(mask, eye, x))
+        return torch.where(mask if matrix else diagonal, exact(p, x), out)
+
+    def _general_exp(self, p, v):
         if self.dim == 2:
             return _spd2.exp(p, v)
         s, si = self._whiten(p)
         return sym(s @ symmetric_function(si @ v @ si, "exp") @ s)
 
-    def _log(self, p, x):
+    def _general_log(self, p, x):
         if self.dim == 2:
             return _spd2.log(p, x)
         s, si = self._whiten(p)
         return sym(s @ symmetric_function(si @ x @ si, "log") @ s)
 
-    def _dist(self, p, x):
+    def _general_dist(self, p, x):
         if self.dim == 2:
             return _spd2.dist(p, x)
-        si = symmetric_function(distinct(p), "invsqrt")
-        return _log_eigenvalue_norm(si @ x @ si)
+        return safe_norm(_log_generalized_eigenvalues(p, x), dim=-1)
 
     def _norm(self, p, v):
         si = symmetric_function(distinct(p), "invsqrt")
         return safe_norm(si @ v @ si, dim=(-2, -1))
 
     def _pairwise_dist(self, A, B):
-        if self.dim == 2:
-            return _spd2.dist(A.unsqueeze(-3), B.unsqueeze(-4))
-        # Whiten each point of A once, not once per pair.
-        si = symmetric_function(A, "invsqrt").unsqueeze(-3)
-        inner = si @ B.unsqueeze(-4) @ si
-        return _log_eigenvalue_norm(inner)
+        return self._dist(A.unsqueeze(-3), B.unsqueeze(-4))
 
     def extreme_scale(self, points):
         eigenvalues = np.linalg.eigvalsh(points)
@@ -173,10 +200,17 @@ class SPD(Manifold):
         scale = x.abs().amax(dim=(-2, -1)).clamp_min(1.0)
         asymmetry = (x - x.mT).abs().amax(dim=(-2, -1)) / scale
         not_symmetric = asymmetry > atol
-        w = torch.linalg.eigvalsh(sym(x))
-        not_pd = (w[..., 0] <= 0) & ~not_symmetric
         eye = torch.eye(self.dim, dtype=torch.bool, device=x.device)
         diagonal = (x.masked_fill(eye, 0.0) == 0).all(-1).all(-1)
+        # a diagonal matrix's eigenvalues are its entries, at any spread (eigvalsh scales
+        # the matrix and loses entries 1e-300 beside 1e+300)
+        eye_values = torch.eye(self.dim, dtype=x.dtype, device=x.device)
+        w = torch.where(
+            diagonal[..., None],
+            torch.diagonal(x, dim1=-2, dim2=-1).sort(-1).values,
+            torch.linalg.eigvalsh(torch.where(diagonal[..., None, None], eye_values, sym(x))),
+        )
+        not_pd = (w[..., 0] <= 0) & ~not_symmetric
         # a matrix that is not diagonal keeps its eigenvalues in float64 only while they
         # span fewer than 1 / MAX_CONDITION: below that, the smallest are rounding noise
         ill = ~not_symmetric & ~not_pd & ~diagonal & (w[..., 0] < w[..., -1] / MAX_CONDITION)
@@ -227,8 +261,86 @@ class SPD(Manifold):
         return root @ s @ root
 
 
-def _log_eigenvalue_norm(S):
-    """``||logm(S)||_F`` of SPD matrices from their eigenvalues alone (no eigenvectors, no
-    reconstruction); its gradient, ``U diag(log(w) / w) U^T / ||.||``, has no
-    ``1 / (w_i - w_j)`` terms and stays finite for repeated eigenvalues."""
-    return safe_norm(torch.log(eigenvalues(S)), dim=-1)
+def _is_diagonal(p: torch.Tensor) -> torch.Tensor:
+    """Whether each matrix of ``p`` (..., k, k) has zeros off its diagonal."""
+    k = p.shape[-1]
+    off = ~torch.eye(k, dtype=torch.bool, device=p.device).flatten()
+    return (p.flatten(-2)[..., off] == 0).all(-1)
+
+
+def _diagonal_entries(p: torch.Tensor) -> torch.Tensor:
+    return torch.diagonal(p, dim1=-2, dim2=-1)
+
+
+def _log_entries(p: torch.Tensor) -> torch.Tensor:
+    """Logs of the diagonal entries (finite for any pair: the other branch of where())."""
+    return torch.log(_diagonal_entries(p).abs().clamp_min(1e-300))
+
+
+def _diagonal_log(p: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
+    """``Log_p(x)`` of diagonal points: ``diag(p_i (log x_i - log p_i))``."""
+    return torch.diag_embed(_diagonal_entries(p) * (_log_entries(x) - _log_entries(p)))
+
+
+def _diagonal_exp(p: torch.Tensor, v: torch.Tensor) -> torch.Tensor:
+    """``Exp_p(v)`` of a diagonal point and vector: ``diag(p_i exp(v_i / p_i))`` (the
+    exponent capped below float64's overflow, for the pairs where() does not keep)."""
+    entries = _diagonal_entries(p)
+    safe = torch.where(entries == 0, torch.ones_like(entries), entries)
+    # exp(log p_i + v_i / p_i): p_i exp(v_i / p_i) would overflow or go subnormal first
+    exponent = (_log_entries(p) + _diagonal_entries(v) / safe).clamp(max=709.0)
+    return torch.diag_embed(torch.exp(exponent))
+
+
+def _diagonal_dist(p: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
+    """The distance of diagonal points, ``||log diag(x) - log diag(p)||``: the log-ratios
+    of their entries without the ratios (any other pair gets a finite, unused value)."""
+    return safe_norm(_log_entries(x) - _log_entries(p), dim=-1)
+
+
+def _congruence(L: torch.Tensor, X: torch.Tensor) -> torch.Tensor:
+    """``L^-1 X L^-T`` (``L`` lower triangular, ``X`` symmetric) by two triangular solves."""
+    half = torch.linalg.solve_triangular(L, X, upper=False)  # L^-1 X
+    return sym(torch.linalg.solve_triangular(L, half.mT, upper=False))
+
+
+#: Spread of a pair's eigenvalues (largest over smallest) up to which the forward side
+#: alone keeps them to about ``eps * 1e4``: beyond it, the reverse pair is computed too.
+SMALL_EIGENVALUES_KEPT = 1e4
+
+
+def _log_generalized_eigenvalues(p: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
+    """Ascending logs of the eigenvalues of ``p^-1 x`` (the whitened matrix's), each from
+    the side that holds it accurately.
+
+    The eigenvalues of ``L^-1 x L^-T`` (``p = L L^T``) carry absolute errors of about
+    ``eps`` times the largest: the large ones are accurate, the small ones lose their
+    digits as the spread grows (the whitened matrix of two points of condition 1e10 has
+    eigenvalues 1e-10 .. 1e10). The reverse pair ``(x, p)`` holds the inverses, its large
+    ones accurate: each log-eigenvalue is taken from the side where it lies on the large
+    half of the log-spectrum (the route of the DTW kernels, which keep the smallest of
+    the reverse pair). Gradients through :func:`eigenvalues`: finite for repeated ones.
+    """
+    # cholesky reads one triangle: symmetric parts, so that the gradient goes to both;
+    # p's factor once per distinct point (a broadcast mean is factored once)
+    p_factor = torch.linalg.cholesky(sym(distinct(p)))
+    p, x = sym(p), sym(x)
+    forward = eigenvalues(_congruence(p_factor, x))
+    spread = forward[..., 0] * SMALL_EIGENVALUES_KEPT < forward[..., -1]
+    if forward.device.type == "cpu" and not bool(spread.any()):
+        # every eigenvalue within 1e4 of the largest keeps 12 digits: no reverse pair
+        # (the usual case; on a GPU the test would wait for the device, so both run)
+        return torch.log(forward)
+    reverse = eigenvalues(_congruence(torch.linalg.cholesky(x), p))
+    return _combine(forward, reverse)
+
+
+def _combine(forward: torch.Tensor, reverse: torch.Tensor) -> torch.Tensor:
+    """Ascending log-eigenvalues from a pair's ascending eigenvalues (``forward``) and its
+    reverse pair's (``reverse``, the inverses): each from the side where it is large."""
+    tiny = torch.finfo(forward.dtype).tiny
+    log_forward = torch.log(forward.clamp_min(tiny))
+    log_reverse = -torch.log(reverse.clamp_min(tiny)).flip(-1)
+    # the middle of the log-spectrum, from the two accurate ends
+    middle = 0.5 * (log_forward[..., -1:] + log_reverse[..., :1])
+    return torch.where(log_forward >= middle, log_forward, log_reverse)
