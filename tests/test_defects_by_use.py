@@ -121,3 +121,26 @@ def test_spd_maps_refuse_a_tangent_vector_that_is_not_symmetric(k):
     symmetric[0, 1] += 1e-9
     expected = space.exp(P, (symmetric + symmetric.T) / 2)
     np.testing.assert_allclose(space.exp(P, symmetric), expected, rtol=1e-8)
+
+
+@pytest.mark.parametrize("pipeline", [False, True])
+def test_prototype_readout_parameters_are_checked_before_any_work(pipeline, monkeypatch):
+    """A readout refused by scikit-learn's own check was refused only after the centroids
+    and the out-of-fold refits; now before the centroids are fitted (a fit that starts
+    them would fail the test)."""
+    from sklearn.linear_model import LogisticRegression
+    from sklearn.pipeline import make_pipeline
+    from sklearn.preprocessing import StandardScaler
+
+    from sk_rtw import RTWNearestCentroid, RTWPrototypeClassifier
+
+    def no_centroids(*args, **kwargs):
+        raise AssertionError("the centroids were fitted before the readout was checked")
+
+    monkeypatch.setattr(RTWNearestCentroid, "fit", no_centroids)
+    readout = LogisticRegression(C=-1)
+    if pipeline:
+        readout = make_pipeline(StandardScaler(), readout)
+    X = np.random.default_rng(0).standard_normal((8, 20))
+    with pytest.raises(ValueError, match="readout: The 'C' parameter of LogisticRegression"):
+        RTWPrototypeClassifier(readout=readout).fit(X, [0, 1] * 4)

@@ -89,6 +89,20 @@ def default_readout() -> Pipeline:
     return make_pipeline(StandardScaler(), RidgeClassifierCV(alphas=np.logspace(-3, 3, 13)))
 
 
+def _check_readout_parameters(readout: Any) -> None:
+    """The readout's own parameters checked before the centroids are fitted (scikit-learn
+    checks them only inside the readout's ``fit``, which comes after the out-of-fold
+    refits): ``_validate_params`` of every scikit-learn estimator in it that has one."""
+    steps = [step for _, step in readout.steps] if isinstance(readout, Pipeline) else [readout]
+    for step in steps:
+        validate = getattr(step, "_validate_params", None)
+        if callable(validate):
+            try:
+                validate()
+            except (TypeError, ValueError) as error:  # InvalidParameterError is both
+                raise type(error)(f"readout: {error}") from error
+
+
 def _readout_has(name: str):
     """The method exists where the fitted decision is the nearest centroid's (which has
     it) or the readout has it."""
@@ -285,6 +299,7 @@ class RTWPrototypeClassifier(ClassifierMixin, TransformerMixin, BaseEstimator):
             )
         params = validate_parameters(self)  # every parameter checked before any work
         readout = default_readout() if params["readout"] is None else clone(params["readout"])
+        _check_readout_parameters(readout)
         # one integer seed for the whole fit: the refits then get the seeds the fit drew
         # and the decision's cross-validation the folds of the out-of-fold distances,
         # whatever random_state is (an int, None, a RandomState or a Generator)
