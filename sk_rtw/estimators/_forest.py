@@ -103,6 +103,13 @@ class RTWProximityForest(ClassifierMixin, BaseEstimator):
     prediction time grow with ``n_trees``; ``n_jobs`` builds and queries the trees on
     several threads with the same result.
 
+    Measured (UCR page, one thread, 100 trees): on UCR datasets of 16-180 training
+    series, 0.90-0.93 mean accuracy where :class:`RTWNearestCentroid` reads 0.85-0.86
+    (Proximity Forest 1.0's published 0.90, MiniRocket's 0.92-0.93); fit 0.4 s to
+    3 minutes per dataset, 1.5-2x Proximity Forest 2.0's published single-CPU time;
+    prediction about 3x aeon's 1-NN DTW (median per dataset). A training set of 8,926
+    short series takes 40 minutes to fit.
+
     Parameters
     ----------
     %(parameters)s
