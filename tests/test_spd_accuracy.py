@@ -113,3 +113,24 @@ def test_class_means_of_widely_spread_diagonal_series_stay_finite():
     clf = RTWNearestCentroid(manifold="spd", method="dba", random_state=0).fit(X, y)
     assert np.isfinite(clf.class_distances(X)).all()
     assert clf.score(X, y) == 1.0
+
+
+@pytest.mark.parametrize("k", [2, 3])
+@pytest.mark.parametrize("scale", [1e50, 1e100, 1e160, 1e300])
+def test_points_of_far_apart_scales(k, scale):
+    """s A against B / s: the log-eigenvalues of A^-1 B shifted by -2 log s. The closed
+    forms' products overflowed from about 1e+-75 (SPD(2) gave NaN): each point is now
+    taken at a power of two near its scale, the log of the ratio added back; Log, Exp and
+    the norm the same way."""
+    rng = np.random.default_rng(k)
+    A, B = (
+        R @ np.diag(np.arange(1.0, k + 1.0) ** sign) @ R.T
+        for R, sign in ((special_ortho_group.rvs(k, random_state=rng), s) for s in (1, -1))
+    )
+    logs = np.log(np.linalg.eigvals(np.linalg.solve(A, B)).real) - 2 * np.log(scale)
+    expected = np.sqrt(np.sum(logs**2))
+    space, P, X = SPD(k), scale * A, B / scale
+    assert space.dist(P, X) == pytest.approx(expected, rel=1e-12)
+    v = space.log(P, X)
+    assert space.norm(P, v) == pytest.approx(expected, rel=1e-12)
+    np.testing.assert_allclose(space.exp(P, v), X, rtol=1e-11, atol=1e-11 * np.abs(X).max())

@@ -140,23 +140,57 @@ class SPD(Manifold):
         return torch.where(mask if matrix else diagonal, exact(p, x), out)
 
     def _general_exp(self, p, v):
-        if self.dim == 2:
+        # Exp_p(v) = 2^e Exp_p'(v / 2^e) for p = 2^e p': the maps in points of scale ~1
+        exponent = _scale_exponent(p)
+        if self.dim == 2 and _near_unit_scale(exponent):
             return _spd2.exp(p, v)
+        p, v = _unscaled(p, exponent), _unscaled(v, exponent)
+        # and Exp_p'(v') = 2^n Exp_p'(v' - n ln 2 p'): n the whitened vector's mean
+        # eigenvalue in powers of two, so that the result's own scale leaves the matrix
+        # exponential (the result may lie 1e+-300 from p)
+        whitened = torch.linalg.solve(p.detach(), v.detach())
+        n = torch.round(torch.diagonal(whitened, dim1=-2, dim2=-1).mean(-1) / math.log(2.0))
+        v = v - (n * math.log(2.0))[..., None, None] * sym(p)
+        if self.dim == 2:
+            return _scaled(_spd2.exp(p, v), exponent + n)
         s, si = self._whiten(p)
-        return sym(s @ symmetric_function(si @ v @ si, "exp") @ s)
+        return _scaled(sym(s @ symmetric_function(si @ v @ si, "exp") @ s), exponent + n)
 
     def _general_log(self, p, x):
-        if self.dim == 2:
+        # Log_p(x) = 2^e (Log_p'(x') + (f - e) ln 2 p') for p = 2^e p', x = 2^f x'
+        p_exponent, x_exponent = _scale_exponent(p), _scale_exponent(x)
+        if self.dim == 2 and _near_unit_scale(p_exponent) and _near_unit_scale(x_exponent):
             return _spd2.log(p, x)
-        s, si = self._whiten(p)
-        return sym(s @ symmetric_function(si @ x @ si, "log") @ s)
+        p, x = _unscaled(p, p_exponent), _unscaled(x, x_exponent)
+        if self.dim == 2:
+            log = _spd2.log(p, x)
+        else:
+            s, si = self._whiten(p)
+            log = sym(s @ symmetric_function(si @ x @ si, "log") @ s)
+        shift = ((x_exponent - p_exponent) * math.log(2.0))[..., None, None]
+        return _scaled(log + shift * sym(p), p_exponent)  # sym: as the maps read p
 
     def _general_dist(self, p, x):
+        # each point divided by a power of two near its scale (exact), the log of the
+        # ratio added back to every log-eigenvalue: points whose scales differ by 1e+-100
+        # and more (valid points) would over- or underflow the congruence otherwise
+        p_exponent, x_exponent = _scale_exponent(p), _scale_exponent(x)
+        shift = (x_exponent - p_exponent) * math.log(2.0)
         if self.dim == 2:
-            return _spd2.dist(p, x)
-        return safe_norm(_log_generalized_eigenvalues(p, x), dim=-1)
+            # the compiled closed form, where the scales are close (its products square
+            # them); the eigenvalue route beyond
+            far = shift.abs() > SPD2_SCALE_GAP
+            if shift.device.type != "cpu" or not bool(far.any()):
+                return _spd2.dist(p, x)
+        logs = _log_generalized_eigenvalues(
+            torch.ldexp(p, -p_exponent[..., None, None]),
+            torch.ldexp(x, -x_exponent[..., None, None]),
+        )
+        return safe_norm(logs + shift.unsqueeze(-1), dim=-1)
 
     def _norm(self, p, v):
+        exponent = _scale_exponent(p)  # ||p^-1/2 v p^-1/2|| is that of p / 2^e, v / 2^e
+        p, v = _unscaled(p, exponent), _unscaled(v, exponent)
         si = symmetric_function(distinct(p), "invsqrt")
         return safe_norm(si @ v @ si, dim=(-2, -1))
 
@@ -302,6 +336,33 @@ def _congruence(L: torch.Tensor, X: torch.Tensor) -> torch.Tensor:
     """``L^-1 X L^-T`` (``L`` lower triangular, ``X`` symmetric) by two triangular solves."""
     half = torch.linalg.solve_triangular(L, X, upper=False)  # L^-1 X
     return sym(torch.linalg.solve_triangular(L, half.mT, upper=False))
+
+
+#: Log-ratio of two SPD(2) points' scales (natural log) beyond which their distance
+#: leaves the closed form (whose intermediate products overflow from about 1e+-75).
+SPD2_SCALE_GAP = 100.0
+
+
+def _scale_exponent(p: torch.Tensor) -> torch.Tensor:
+    """The power of two nearest the mean diagonal entry of each point (a float tensor:
+    ``torch.ldexp`` takes it), detached: a constant factor of the point."""
+    mean = torch.diagonal(p, dim1=-2, dim2=-1).mean(-1).detach()
+    return torch.round(torch.log2(mean.abs().clamp_min(1e-300)))
+
+
+def _unscaled(p: torch.Tensor, exponent: torch.Tensor) -> torch.Tensor:
+    return torch.ldexp(p, -exponent[..., None, None])
+
+
+def _scaled(p: torch.Tensor, exponent: torch.Tensor) -> torch.Tensor:
+    return torch.ldexp(p, exponent[..., None, None])
+
+
+def _near_unit_scale(exponent: torch.Tensor) -> bool:
+    """Whether the SPD(2) closed forms can take these points as they are (their products
+    square the entries): every scale within 2^+-200 of 1, tested on the CPU only (on a
+    GPU the test would wait for the device: the points are rescaled there)."""
+    return exponent.device.type == "cpu" and not bool((exponent.abs() > 200).any())
 
 
 #: Spread of a pair's eigenvalues (largest over smallest) up to which the forward side
