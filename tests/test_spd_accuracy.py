@@ -134,3 +134,13 @@ def test_points_of_far_apart_scales(k, scale):
     v = space.log(P, X)
     assert space.norm(P, v) == pytest.approx(expected, rel=1e-12)
     np.testing.assert_allclose(space.exp(P, v), X, rtol=1e-11, atol=1e-11 * np.abs(X).max())
+
+
+def test_the_kernels_name_entries_beyond_their_range():
+    """A valid non-diagonal point with entries 1e160 leaves the kernels' range (they
+    square entries): the message says so and how to rescale, not "no Cholesky factor"."""
+    rng = np.random.default_rng(0)
+    R = special_ortho_group.rvs(2, random_state=rng)
+    P = 1e160 * (R @ np.diag([1.0, 2.0]) @ R.T)
+    with pytest.raises(ValueError, match=r"entries of magnitude \d.*e\+160.*rescale the series"):
+        dtw_distance(P[None], np.eye(2)[None], "spd")

@@ -88,6 +88,14 @@ def kernel_points(manifold: Manifold, flat: np.ndarray) -> np.ndarray:
             bad = ~np.isfinite(features).all(1)
             if bad.any():
                 point = points[int(np.argmax(bad)), start:stop].reshape(k, k)
+                largest = float(np.abs(point).max())
+                if largest > 1e150 or largest < 1e-150:
+                    raise ValueError(
+                        f"the SPD({k}) point {point.tolist()} has entries of magnitude "
+                        f"{largest:.3g}: the DTW kernels square them, beyond float64's range "
+                        "from 1e+-154; rescale the series (the affine-invariant distance does "
+                        "not change when every point is multiplied by one number)"
+                    )
                 raise ValueError(
                     f"the SPD({k}) point {point.tolist()} has no Cholesky factor in float64 "
                     "(it is not positive definite, or too close to singular); regularise "
