@@ -48,7 +48,8 @@ EXEMPLARS = Parameter(
     (Options(("series", "mean")),),
     'Each branch\'s exemplar: "series" one training series of its class, drawn at random '
     '(the published recipe); "mean" the DBA mean of a random subset of the class (about '
-    "the square root of its size, at most 10 series), several times slower to fit.",
+    "the square root of its size, at most 10 series): about 3x the fit, and 0.5 points "
+    "less accurate on half B of the UCR page (better on 4 of its datasets, worse on 7).",
 )
 MAX_DEPTH = Parameter(
     "max_depth",
