@@ -109,7 +109,7 @@ class RTWProximityForest(ClassifierMixin, BaseEstimator):
     (Proximity Forest 1.0's published 0.90, MiniRocket's 0.92-0.93); fit 0.4 s to
     3 minutes per dataset, 1.5-2x Proximity Forest 2.0's published single-CPU time;
     prediction about 3x aeon's 1-NN DTW (median per dataset). A training set of 8,926
-    short series takes 40 minutes to fit.
+    short series takes half an hour to fit.
 
     Parameters
     ----------
