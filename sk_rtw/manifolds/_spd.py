@@ -102,6 +102,8 @@ class SPD(Manifold):
 
     def _group_log(self, means, codes, points):
         general = self._general_group_log(means, codes, points)
+        if _ordinary(means, points):
+            return general
         expanded = group_expand(means, codes)
         diagonal = (_is_diagonal(expanded) & _is_diagonal(points))[..., None, None]
         return torch.where(diagonal, _diagonal_log(expanded, points), general)
@@ -116,81 +118,82 @@ class SPD(Manifold):
         s, si = group_expand(s, codes), group_expand(si, codes)
         return sym(s @ symmetric_function(si @ points @ si, "log") @ s)
 
-    # Pairs of diagonal points (a diagonal point and a diagonal vector for exp) take the
-    # maps and the distance entry by entry, exact at any spread: the closed forms and the
-    # whitening lose the small entries beside large ones (to cancellation, or to ratios
-    # that over- or underflow beyond 1e+-154). The general route gets the identity there,
-    # so that no NaN of it reaches the gradient through where().
+    # The maps and the distance take ordinary points (:func:`_ordinary`) as they are.
+    # Pairs of diagonal points (a diagonal point and a diagonal vector for exp) take them
+    # entry by entry, exact at any spread: the closed forms and the whitening lose the
+    # small entries beside large ones (to cancellation, or to ratios that over- or
+    # underflow beyond 1e+-154); the other pairs are taken at a power of two near each
+    # point's scale (the ``_rescaled_*`` routes). The general route gets the identity at
+    # diagonal pairs, so that no NaN of it reaches the gradient through where().
     def _exp(self, p, v):
-        return self._diagonal_aware(p, v, self._general_exp, _diagonal_exp, matrix=True)
+        return self._careful(p, v, self._plain_exp, self._rescaled_exp, _diagonal_exp,
+                             matrix=True, x_is_point=False)  # fmt: skip
 
     def _log(self, p, x):
-        return self._diagonal_aware(p, x, self._general_log, _diagonal_log, matrix=True)
+        return self._careful(p, x, self._plain_log, self._rescaled_log, _diagonal_log,
+                             matrix=True)  # fmt: skip
 
     def _dist(self, p, x):
-        return self._diagonal_aware(p, x, self._general_dist, _diagonal_dist, matrix=False)
+        return self._careful(p, x, self._plain_dist, self._rescaled_dist, _diagonal_dist,
+                             matrix=False)  # fmt: skip
 
-    def _diagonal_aware(self, p, x, general, exact, matrix):
+    def _careful(self, p, x, plain, rescaled, exact, matrix, x_is_point=True):
+        if _ordinary(p, x, x_is_point):
+            return plain(p, x)  # the usual case, at the closed forms' speed
         diagonal = _is_diagonal(p) & _is_diagonal(x)
-        if diagonal.device.type == "cpu" and not bool(diagonal.any()):
-            return general(p, x)  # the usual case, at its own speed (no sync on a GPU)
         eye = torch.eye(self.dim, dtype=p.dtype, device=p.device)
         mask = diagonal[..., None, None]
-        out = general(torch.where(mask, eye, p), torch.where(mask, eye, x))
+        out = rescaled(torch.where(mask, eye, p), torch.where(mask, eye, x))
         return torch.where(mask if matrix else diagonal, exact(p, x), out)
 
-    def _general_exp(self, p, v):
-        # Exp_p(v) = 2^e Exp_p'(v / 2^e) for p = 2^e p': the maps in points of scale ~1
-        exponent = _scale_exponent(p)
-        if self.dim == 2 and _near_unit_scale(exponent):
+    def _plain_exp(self, p, v):
+        if self.dim == 2:
             return _spd2.exp(p, v)
+        s, si = self._whiten(p)
+        return sym(s @ symmetric_function(si @ v @ si, "exp") @ s)
+
+    def _plain_log(self, p, x):
+        if self.dim == 2:
+            return _spd2.log(p, x)
+        s, si = self._whiten(p)
+        return sym(s @ symmetric_function(si @ x @ si, "log") @ s)
+
+    def _plain_dist(self, p, x):
+        if self.dim == 2:
+            return _spd2.dist(p, x)
+        return safe_norm(_log_generalized_eigenvalues(p, x), dim=-1)
+
+    def _rescaled_exp(self, p, v):
+        # Exp_p(v) = 2^e Exp_p'(v / 2^e) for p = 2^e p', and Exp_p'(v') = 2^n Exp_p'(v' -
+        # n ln 2 p') with n the whitened vector's mean eigenvalue in powers of two, so that
+        # the result's own scale leaves the matrix exponential (it may lie 1e+-300 from p)
+        exponent = _scale_exponent(p)
         p, v = _unscaled(p, exponent), _unscaled(v, exponent)
-        # and Exp_p'(v') = 2^n Exp_p'(v' - n ln 2 p'): n the whitened vector's mean
-        # eigenvalue in powers of two, so that the result's own scale leaves the matrix
-        # exponential (the result may lie 1e+-300 from p)
         whitened = torch.linalg.solve(p.detach(), v.detach())
         n = torch.round(torch.diagonal(whitened, dim1=-2, dim2=-1).mean(-1) / math.log(2.0))
         v = v - (n * math.log(2.0))[..., None, None] * sym(p)
-        if self.dim == 2:
-            return _scaled(_spd2.exp(p, v), exponent + n)
-        s, si = self._whiten(p)
-        return _scaled(sym(s @ symmetric_function(si @ v @ si, "exp") @ s), exponent + n)
+        return _scaled(self._plain_exp(p, v), exponent + n)
 
-    def _general_log(self, p, x):
+    def _rescaled_log(self, p, x):
         # Log_p(x) = 2^e (Log_p'(x') + (f - e) ln 2 p') for p = 2^e p', x = 2^f x'
         p_exponent, x_exponent = _scale_exponent(p), _scale_exponent(x)
-        if self.dim == 2 and _near_unit_scale(p_exponent) and _near_unit_scale(x_exponent):
-            return _spd2.log(p, x)
         p, x = _unscaled(p, p_exponent), _unscaled(x, x_exponent)
-        if self.dim == 2:
-            log = _spd2.log(p, x)
-        else:
-            s, si = self._whiten(p)
-            log = sym(s @ symmetric_function(si @ x @ si, "log") @ s)
         shift = ((x_exponent - p_exponent) * math.log(2.0))[..., None, None]
-        return _scaled(log + shift * sym(p), p_exponent)  # sym: as the maps read p
+        log = self._plain_log(p, x) + shift * sym(p)  # sym: as the maps read p
+        return _scaled(log, p_exponent)
 
-    def _general_dist(self, p, x):
-        # each point divided by a power of two near its scale (exact), the log of the
-        # ratio added back to every log-eigenvalue: points whose scales differ by 1e+-100
-        # and more (valid points) would over- or underflow the congruence otherwise
+    def _rescaled_dist(self, p, x):
+        # the log of the scales' ratio added to every log-eigenvalue of p' and x'
         p_exponent, x_exponent = _scale_exponent(p), _scale_exponent(x)
         shift = (x_exponent - p_exponent) * math.log(2.0)
-        if self.dim == 2:
-            # the compiled closed form, where the scales are close (its products square
-            # them); the eigenvalue route beyond
-            far = shift.abs() > SPD2_SCALE_GAP
-            if shift.device.type != "cpu" or not bool(far.any()):
-                return _spd2.dist(p, x)
-        logs = _log_generalized_eigenvalues(
-            torch.ldexp(p, -p_exponent[..., None, None]),
-            torch.ldexp(x, -x_exponent[..., None, None]),
-        )
+        logs = _log_generalized_eigenvalues(_unscaled(p, p_exponent), _unscaled(x, x_exponent))
         return safe_norm(logs + shift.unsqueeze(-1), dim=-1)
 
     def _norm(self, p, v):
-        exponent = _scale_exponent(p)  # ||p^-1/2 v p^-1/2|| is that of p / 2^e, v / 2^e
-        p, v = _unscaled(p, exponent), _unscaled(v, exponent)
+        if p.device.type != "cpu" or not _in_unit_range(p):
+            # ||p^-1/2 v p^-1/2|| is that of p / 2^e, v / 2^e: points of any scale
+            exponent = _scale_exponent(p)
+            p, v = _unscaled(p, exponent), _unscaled(v, exponent)
         si = symmetric_function(distinct(p), "invsqrt")
         return safe_norm(si @ v @ si, dim=(-2, -1))
 
@@ -234,15 +237,14 @@ class SPD(Manifold):
         scale = x.abs().amax(dim=(-2, -1)).clamp_min(1.0)
         asymmetry = (x - x.mT).abs().amax(dim=(-2, -1)) / scale
         not_symmetric = asymmetry > atol
-        eye = torch.eye(self.dim, dtype=torch.bool, device=x.device)
-        diagonal = (x.masked_fill(eye, 0.0) == 0).all(-1).all(-1)
+        diagonal = _is_diagonal(x)
         # a diagonal matrix's eigenvalues are its entries, at any spread (eigvalsh scales
         # the matrix and loses entries 1e-300 beside 1e+300)
-        eye_values = torch.eye(self.dim, dtype=x.dtype, device=x.device)
+        eye = torch.eye(self.dim, dtype=x.dtype, device=x.device)
         w = torch.where(
             diagonal[..., None],
             torch.diagonal(x, dim1=-2, dim2=-1).sort(-1).values,
-            torch.linalg.eigvalsh(torch.where(diagonal[..., None, None], eye_values, sym(x))),
+            torch.linalg.eigvalsh(torch.where(diagonal[..., None, None], eye, sym(x))),
         )
         not_pd = (w[..., 0] <= 0) & ~not_symmetric
         # a matrix that is not diagonal keeps its eigenvalues in float64 only while they
@@ -338,11 +340,6 @@ def _congruence(L: torch.Tensor, X: torch.Tensor) -> torch.Tensor:
     return sym(torch.linalg.solve_triangular(L, half.mT, upper=False))
 
 
-#: Log-ratio of two SPD(2) points' scales (natural log) beyond which their distance
-#: leaves the closed form (whose intermediate products overflow from about 1e+-75).
-SPD2_SCALE_GAP = 100.0
-
-
 def _scale_exponent(p: torch.Tensor) -> torch.Tensor:
     """The power of two nearest the mean diagonal entry of each point (a float tensor:
     ``torch.ldexp`` takes it), detached: a constant factor of the point."""
@@ -358,11 +355,29 @@ def _scaled(p: torch.Tensor, exponent: torch.Tensor) -> torch.Tensor:
     return torch.ldexp(p, exponent[..., None, None])
 
 
-def _near_unit_scale(exponent: torch.Tensor) -> bool:
-    """Whether the SPD(2) closed forms can take these points as they are (their products
-    square the entries): every scale within 2^+-200 of 1, tested on the CPU only (on a
-    GPU the test would wait for the device: the points are rescaled there)."""
-    return exponent.device.type == "cpu" and not bool((exponent.abs() > 200).any())
+#: Diagonal entries within ``2^+-UNIT_RANGE`` of 1 keep the closed forms (their products
+#: square the entries) and the whitening in range.
+UNIT_RANGE = 200
+
+
+def _in_unit_range(p: torch.Tensor) -> bool:
+    if p.numel() == 0:
+        return True
+    low, high = torch.aminmax(torch.diagonal(p, dim1=-2, dim2=-1))
+    return bool(low > 2.0**-UNIT_RANGE) and bool(high < 2.0**UNIT_RANGE)
+
+
+def _ordinary(p: torch.Tensor, x: torch.Tensor, x_is_point: bool = True) -> bool:
+    """Whether the maps and the distance can take ``p`` and ``x`` as they are: on the
+    CPU (on a GPU the test would wait for the device: the careful routes run there),
+    every diagonal entry within ``2^+-UNIT_RANGE`` and no pair of diagonal matrices (one
+    needs a zero at ``[0, 1]`` in both). Two aminmax and two comparisons: the usual
+    case pays little for the careful routes."""
+    if p.device.type != "cpu" or p.shape[-1] == 1 or not _in_unit_range(p):
+        return False  # SPD(1): every point is diagonal
+    if x_is_point and not _in_unit_range(x):
+        return False
+    return not (bool((p[..., 0, 1] == 0).any()) and bool((x[..., 0, 1] == 0).any()))
 
 
 #: Spread of a pair's eigenvalues (largest over smallest) up to which the forward side
