@@ -1,4 +1,5 @@
-"""What every benchmark script starts with: argument types, output checks, method objects.
+"""What every benchmark script starts with: argument types, output checks, method objects,
+smooth test series.
 
 Each script runs on its own (``python benchmarks/ucr/run.py``); its one start line puts
 the repository on ``sys.path`` (Python looks only in the script's folder), then
@@ -17,6 +18,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import torch
 
 from sk_rtw.methods import AveragingMethod, get_method
@@ -122,3 +124,16 @@ def best_time(call: Callable[[], object], repeats: int, *, warm_up: bool = False
         call()
         times.append(time.perf_counter() - start)
     return min(times)
+
+
+def smooth_series(manifold, n_series: int, length: int, seed: int = 0) -> np.ndarray:
+    """Series that move smoothly on ``manifold``: a random start walked along random
+    tangent steps (``exp`` of a small step at every sample)."""
+    rng = np.random.default_rng(seed)
+    points = manifold.random_point(n_series, random_state=rng)
+    out = np.empty((n_series, length, *manifold.point_shape))
+    for t in range(length):
+        out[:, t] = points
+        step = np.stack([manifold.random_tangent(p, 0.05, random_state=rng) for p in points])
+        points = np.asarray(manifold.exp(points, step))
+    return out

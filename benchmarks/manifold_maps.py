@@ -7,11 +7,11 @@ Usage::
 
 The maps one epoch of ``align`` runs -- ``Log``, ``Exp`` and the distance between the
 samples of 30 smooth series of 100 samples and one base point per sample broadcast over
-the series -- without and with their gradient, on one thread: compiled (the CPU float64
-path: :mod:`sk_rtw.manifolds._sphere_kernels` for spheres and unit quaternions,
-:mod:`sk_rtw.manifolds._spd2_kernels` for SPD(2)) and as the torch formulas (the path on
-other devices and dtypes, selected through each module's private switch ``compiled``),
-and their ratio (best of ``--repeats`` x 10 calls after a warm-up).
+the series -- without and with their gradient, on one thread, through the manifolds'
+public maps: compiled (the CPU float64 path of spheres, unit quaternions and SPD(2)) and
+as the torch formulas (the path on other devices and dtypes, selected on the CPU with
+:func:`sk_rtw.manifolds.compiled_maps`), and their ratio (best of ``--repeats`` x 10
+calls after a warm-up).
 """
 
 from __future__ import annotations
@@ -25,24 +25,11 @@ import torch
 
 sys.path.append(str(Path(__file__).resolve().parents[1]))
 
-from benchmarks._shared import best_time, machine, positive_int
-from benchmarks.spd_speed import smooth_series
-from sk_rtw.manifolds import SPD, Quaternion, Sphere, _spd2, _sphere
+from benchmarks._shared import best_time, machine, positive_int, smooth_series
+from sk_rtw.manifolds import SPD, Quaternion, Sphere, compiled_maps
 
-
-def _maps(name: str):
-    """``(manifold, module with the switch, log, exp, dist)`` of a manifold name."""
-    if name == "spd2":
-        return SPD(2), _spd2, _spd2.log, _spd2.exp, _spd2.dist
-    manifold = Quaternion() if name == "quaternion" else Sphere(2)
-    sign_invariant = name == "quaternion"
-    return (
-        manifold,
-        _sphere,
-        lambda p, x: _sphere._sphere_log(p, x, sign_invariant),
-        _sphere._sphere_exp,
-        lambda p, x: _sphere._sphere_dist(p, x, sign_invariant),
-    )
+#: The manifold of every name.
+SPACES = {"sphere": Sphere(2), "quaternion": Quaternion(), "spd2": SPD(2)}
 
 
 MANIFOLDS = ("sphere", "quaternion", "spd2")
@@ -50,18 +37,17 @@ MANIFOLDS = ("sphere", "quaternion", "spd2")
 
 def map_rows(name: str, repeats: int, n_series: int = 30, length: int = 100) -> None:
     """Print the compiled and torch times of one manifold's maps."""
-    manifold, module, log, exp, dist = _maps(name)
+    manifold = SPACES[name]
+    log, exp, dist = manifold.log, manifold.exp, manifold.dist
     print(f"\n{manifold!r} maps on {n_series} x {length} points, base points broadcast over "
           "the series: compiled / torch formulas")  # fmt: skip
     X = torch.as_tensor(smooth_series(manifold, n_series, length))
     P = X[0:1].expand(n_series, *X.shape[1:])
     with torch.no_grad():
         V = log(P, X)
-    compiled = module.compiled
     for label, function, argument in (("log", log, X), ("exp", exp, V), ("dist", dist, X)):
         seconds = {}
         for path in ("compiled", "torch"):
-            module.compiled = compiled if path == "compiled" else (lambda p, x: False)
             leaf = argument.clone().requires_grad_()
 
             def value(f=function, argument=argument):
@@ -71,9 +57,9 @@ def map_rows(name: str, repeats: int, n_series: int = 30, length: int = 100) -> 
             def gradient(f=function, leaf=leaf):
                 f(P, leaf).sum().backward()
 
-            seconds[path] = [best_time(call, repeats * 10, warm_up=True)
-                             for call in (value, gradient)]  # fmt: skip
-        module.compiled = compiled
+            with compiled_maps(path == "compiled"):
+                seconds[path] = [best_time(call, repeats * 10, warm_up=True)
+                                 for call in (value, gradient)]  # fmt: skip
         (value_c, grad_c), (value_t, grad_t) = seconds["compiled"], seconds["torch"]
         print(f"  {label:>4}: value {value_c * 1e6:6.0f} / {value_t * 1e6:6.0f} us "
               f"({value_t / value_c:.1f}x faster), with its gradient {grad_c * 1e6:6.0f} / "

@@ -55,25 +55,12 @@ import torch
 # there is the one measured
 sys.path.append(str(Path(__file__).resolve().parents[1]))
 
-from benchmarks._shared import best_time, machine, positive_int
+from benchmarks._shared import best_time, machine, positive_int, smooth_series
 from sk_rtw import RTWNearestCentroid, align, dtw_pairwise_distance
 from sk_rtw.baselines import dba_average
 from sk_rtw.manifolds import SPD, Euclidean
 
 SECTIONS = ("dtw", "align", "rlasa", "eigh", "maps")
-
-
-def smooth_series(manifold, n_series: int, length: int, seed: int = 0) -> np.ndarray:
-    """Series that move smoothly on ``manifold``: a random start walked along random
-    tangent steps (``exp`` of a small step at every sample)."""
-    rng = np.random.default_rng(seed)
-    points = manifold.random_point(n_series, random_state=rng)
-    out = np.empty((n_series, length, *manifold.point_shape))
-    for t in range(length):
-        out[:, t] = points
-        step = np.stack([manifold.random_tangent(p, 0.05, random_state=rng) for p in points])
-        points = np.asarray(manifold.exp(points, step))
-    return out
 
 
 def dtw_rows(repeats: int) -> None:

@@ -467,3 +467,38 @@ def test_check_manifold_names_the_broken_property():
         check_manifold(LeavesTheSphere(2))
     with pytest.raises(TypeError, match="pass points="):
         check_manifold(PlaneRotations())
+
+
+@pytest.mark.parametrize("space", [Sphere(2), Quaternion(), SPD(2), SPD(3)], ids=repr)
+def test_compiled_maps_off_runs_the_torch_formulas(space, monkeypatch):
+    """The switch sends every map to the torch formulas (no kernel runs: each kernel
+    module's entry points are made to fail), and both paths agree to rounding."""
+    from sk_rtw.manifolds import _spd2_kernels, _sphere_kernels, _symmetric, compiled_maps
+
+    X = np.asarray(make_warped_signals(space, 2, 30, random_state=0).signals)
+    compiled = [np.asarray(f(X[0], X[1])) for f in (space.log, space.dist)]
+    compiled.append(np.asarray(space.exp(X[0], compiled[0])))
+
+    def fail(*args, **kwargs):
+        raise AssertionError("a compiled kernel ran")
+
+    for module in (_sphere_kernels, _spd2_kernels):
+        for name in dir(module):
+            if not name.startswith("__") and callable(getattr(module, name)):
+                monkeypatch.setattr(module, name, fail)
+    monkeypatch.setattr(_symmetric, "jacobi_eigh", fail)  # SPD(3..6) decompositions
+    with compiled_maps(False):
+        reference = [np.asarray(f(X[0], X[1])) for f in (space.log, space.dist)]
+        reference.append(np.asarray(space.exp(X[0], reference[0])))
+    for a, b in zip(compiled, reference, strict=True):
+        np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12)
+    with pytest.raises(AssertionError, match="compiled kernel"):  # switched back on
+        space.log(X[0], X[1])
+
+
+def test_compiled_maps_checks_its_argument():
+    from sk_rtw.manifolds import compiled_maps
+
+    with pytest.raises(TypeError, match="True or False"):
+        with compiled_maps("no"):
+            pass

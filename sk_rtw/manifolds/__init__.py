@@ -2,6 +2,7 @@
 
 from ._base import Manifold
 from ._check import ManifoldCheckError, check_manifold
+from ._compiled import compiled_maps
 from ._euclidean import Euclidean
 from ._product import Product
 from ._registry import ManifoldSpec, available_manifolds, get_manifold
@@ -19,5 +20,6 @@ __all__ = [
     "Sphere",
     "available_manifolds",
     "check_manifold",
+    "compiled_maps",
     "get_manifold",
 ]

@@ -30,6 +30,7 @@ import torch
 
 from .._backend import safe_sqrt
 from . import _spd2_kernels as kernels
+from ._compiled import compiled_enabled
 from ._symmetric import distinct
 
 #: Below this ``r^2`` (``exp``) or ``(r / m)^2`` (``log``, distance) the even functions of
@@ -221,9 +222,10 @@ def _torch_dist(p: torch.Tensor, x: torch.Tensor) -> torch.Tensor:
 def compiled(p: torch.Tensor | Chart, x: torch.Tensor) -> TypeGuard[torch.Tensor]:
     """Whether :func:`log`, :func:`exp` and :func:`dist` of these arguments run compiled:
     point tensors (not a :class:`Chart`), both float64 on the CPU."""
-    return not isinstance(p, Chart) and all(
-        t.device.type == "cpu" and t.dtype == torch.float64 for t in (p, x)
-    )
+    return (
+        compiled_enabled() and not isinstance(p, Chart)
+        and all(t.device.type == "cpu" and t.dtype == torch.float64 for t in (p, x))
+    )  # fmt: skip
 
 
 def _compiled_map(name: str, p: torch.Tensor, x: torch.Tensor) -> torch.Tensor:

@@ -11,6 +11,7 @@ import torch
 from .._backend import inner, safe_norm
 from . import _sphere_kernels as kernels
 from ._base import Manifold
+from ._compiled import compiled_enabled
 from ._euclidean import _check_dim
 
 # Below this squared norm the closed forms are replaced by their Taylor expansions, so
@@ -112,7 +113,9 @@ def _torch_dist(p: torch.Tensor, x: torch.Tensor, sign_invariant: bool = False) 
 def compiled(p: torch.Tensor, x: torch.Tensor) -> bool:
     """Whether the maps of these arguments run compiled (:mod:`._sphere_kernels`): both
     float64 on the CPU."""
-    return all(t.device.type == "cpu" and t.dtype == torch.float64 for t in (p, x))
+    return compiled_enabled() and all(
+        t.device.type == "cpu" and t.dtype == torch.float64 for t in (p, x)
+    )
 
 
 def _compiled_map(name: str, p: torch.Tensor, x: torch.Tensor, sign_invariant: bool = False):

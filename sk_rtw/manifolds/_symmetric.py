@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import torch
 
+from ._compiled import compiled_enabled
 from ._jacobi import jacobi_eigh
 
 _NAMES = ("exp", "log", "sqrt", "invsqrt")
@@ -94,8 +95,9 @@ JACOBI_MAX_SIZE = 6
 
 def _compiled(S: torch.Tensor) -> bool:
     return (
-        3 <= S.shape[-1] <= JACOBI_MAX_SIZE and S.device.type == "cpu" and S.dtype == torch.float64
-    )
+        compiled_enabled() and 3 <= S.shape[-1] <= JACOBI_MAX_SIZE
+        and S.device.type == "cpu" and S.dtype == torch.float64
+    )  # fmt: skip
 
 
 def _eigh_jacobi(S: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
