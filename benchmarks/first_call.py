@@ -11,10 +11,6 @@ Every probe runs in fresh interpreters (``sys.executable``), as a user meets the
 * ``align``: ``import sk_rtw``, then :func:`sk_rtw.align` three times on the same 8
   unit-quaternion series (T = 50 and T = 1,000), the default settings; the first call
   against the median of the other two is the one-time cost;
-* ``split``: the first ``align`` (T = 50) under cProfile, its time divided into numba
-  kernels loaded from the cache (``Dispatcher._compile_for_args``), imports made during
-  the call, the first epoch (``Trainer.step``'s first call, minus the above), and the rest
-  (profiling slows everything a little: read it as proportions);
 * ``search``: ``GridSearchCV(RTWNearestCentroid(n_centroids=1, dtw_window=None), cv=3)``
   over RTW's ``hidden_size`` and DBA on aeon's GunPoint (its training split), with
   ``n_jobs=1``, ``n_jobs=2`` (joblib's default process workers) and ``n_jobs=2`` on
@@ -28,7 +24,9 @@ Every probe runs in fresh interpreters (``sys.executable``), as a user meets the
   ``learning_rate`` and DBA (5 candidates x 3 folds) on ``--dataset`` from ``--data-dir``
   (the development archive's Plane by default), the same three ways.
 
-Prints one Markdown table per probe with the median over ``--repeat`` processes.
+Prints one Markdown table per probe with the median over ``--repeat`` processes. (The
+``split`` probe, which divided the first ``align`` by patching the trainer, is retired:
+see ``docs/benchmarks/studies.md``.)
 """
 
 from __future__ import annotations
@@ -61,38 +59,6 @@ for T in (50, 1000):
         calls.append(time.perf_counter() - t)
     out[T] = calls
 print(json.dumps(out))
-"""
-
-SPLIT = """
-import cProfile, json, pstats, time
-import numpy as np
-import sk_rtw
-from sk_rtw.align import _training
-from sk_rtw.datasets import make_warped_signals
-X = np.asarray(make_warped_signals("quaternion", 8, 50, random_state=0).signals)
-first = {}
-step = _training.Trainer.step
-def timed(self, *args, **kwargs):
-    if "epoch" not in first:
-        t = time.perf_counter()
-        step(self, *args, **kwargs)
-        first["epoch"] = time.perf_counter() - t
-    else:
-        step(self, *args, **kwargs)
-_training.Trainer.step = timed
-profile = cProfile.Profile()
-t = time.perf_counter()
-profile.enable()
-sk_rtw.align(X, manifold="quaternion", random_state=0)
-profile.disable()
-total = time.perf_counter() - t
-stats = pstats.Stats(profile).stats
-def cumulative(predicate):
-    return sum(v[3] for k, v in stats.items() if predicate(k))
-kernels = cumulative(lambda k: k[2] == "_compile_for_args")
-imports = cumulative(lambda k: k[2] == "_find_and_load")
-print(json.dumps({"total": total, "kernels": kernels, "imports": imports,
-                  "first epoch": first.get("epoch", 0.0)}))
 """
 
 SEARCH = """
@@ -184,20 +150,6 @@ def probe_align(repeat: int) -> str:
     return "\n".join(lines)
 
 
-def probe_split(repeat: int) -> str:
-    runs = [fresh(SPLIT) for _ in range(repeat)]
-    total = median([r["total"] for r in runs])
-    kernels = median([r["kernels"] for r in runs])
-    imports = median([r["imports"] for r in runs])
-    epoch = median([r["first epoch"] for r in runs])
-    rest = total - kernels - imports - epoch
-    return (
-        "| first align, 8 x 50 (profiled) | kernels loaded | imports in the call | "
-        "first epoch | the rest |\n| --- | --- | --- | --- | --- |\n"
-        f"| {total:.2f} s | {kernels:.2f} s | {imports:.2f} s | {epoch:.2f} s | {rest:.2f} s |"
-    )
-
-
 #: (n_jobs, joblib backend, label) of the search probes.
 SEARCHES = (("1", "loky", "n_jobs=1"), ("2", "loky", "n_jobs=2, processes (joblib's default)"),
             ("2", "threading", "n_jobs=2, threads"))  # fmt: skip
@@ -233,8 +185,8 @@ def probe_long_search(repeat: int, dataset: str, data_dir: str) -> str:
     return "\n".join(lines)
 
 
-PROBES = {"align": probe_align, "split": probe_split, "search": probe_search,
-          "worker": probe_worker, "long-search": probe_long_search}  # fmt: skip
+PROBES = {"align": probe_align, "search": probe_search, "worker": probe_worker,
+          "long-search": probe_long_search}  # fmt: skip
 
 
 def main(argv=None) -> None:

@@ -13,6 +13,7 @@ from .dtw import (
     dtw_path,
 )
 from .estimators import (
+    AutoChoice,
     NTWAverager,
     NTWNearestCentroid,
     RTWAverager,
@@ -48,6 +49,7 @@ __all__ = [
     "TTW",
     "AlignedStatistics",
     "Alignment",
+    "AutoChoice",
     "ConfidenceTube",
     "Euclidean",
     "Manifold",

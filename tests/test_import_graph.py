@@ -138,3 +138,80 @@ def test_packages_stand_on_floors():
     assert _circles(packages) == []
     assert "align" not in packages["dtw"] and "methods" not in packages["align"]
     assert "estimators" not in packages["methods"] and "align" not in packages["_settings"]
+
+
+BENCHMARKS = ROOT.parent / "benchmarks"
+#: The benchmark files that may read the library's private steps, with the reason
+#: (``docs/benchmarks/studies.md``): every other script uses the public API.
+PRIVATE_READERS = {
+    "studies/candidates.py": "every candidate's held-out outcome per series (the choice's steps)",
+    "studies/forest_measures.py": "the forest's measure family swapped for a variant",
+}
+
+
+def _private_imports(path: Path) -> list[str]:
+    """The private ``sk_rtw`` modules or names a file imports (anywhere in it, by
+    ``importlib.import_module``, and in code it runs from strings): any ``sk_rtw`` path
+    with a component that starts with ``_``."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    found = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            names = [alias.name for alias in node.names]
+        elif isinstance(node, ast.ImportFrom) and node.module and not node.level:
+            names = [node.module] + [f"{node.module}.{alias.name}" for alias in node.names]
+        elif (
+            isinstance(node, ast.Call) and getattr(node.func, "attr", None) == "import_module"
+            and node.args and isinstance(node.args[0], ast.Constant)
+        ):  # fmt: skip
+            names = [str(node.args[0].value)]
+        elif isinstance(node, ast.Constant) and isinstance(node.value, str):
+            pairs = _string_imports(node.value)
+            names = [a for a, _ in pairs] + [f"{a}.{b}" for a, b in pairs]
+        else:
+            continue
+        for name in names:
+            parts = name.split(".")
+            if parts[0] == "sk_rtw" and any(p.startswith("_") and p != "__version__"
+                                            for p in parts[1:]):  # fmt: skip
+                found.append(name)
+    return found
+
+
+def _string_imports(text: str) -> list[tuple[str, str]]:
+    """``(module, name)`` of the ``from sk_rtw... import name`` and ``import sk_rtw...``
+    lines in code held as a string."""
+    pairs = []
+    for line in text.splitlines():
+        words = line.split()
+        if len(words) >= 4 and words[0] == "from" and words[1].startswith("sk_rtw"):
+            pairs += [(words[1], n.strip(",()")) for n in words[3:] if n.strip(",()")]
+        elif len(words) >= 2 and words[0] == "import" and words[1].startswith("sk_rtw."):
+            module, _, name = words[1].rstrip(",").rpartition(".")
+            pairs.append((module, name))
+    return pairs
+
+
+def test_the_private_import_finder_finds_them(tmp_path):
+    script = tmp_path / "script.py"
+    script.write_text(
+        "from sk_rtw import align\nfrom sk_rtw.align import _training\n"
+        "import sk_rtw._heap\nCODE = '''\nfrom sk_rtw.estimators._selection import WINDOWS\n'''\n"
+        "importlib.import_module('sk_rtw.align._training')\nDOC = 'see sk_rtw.dtw._search'\n"
+    )
+    found = _private_imports(script)
+    assert "sk_rtw.align._training" in found and "sk_rtw._heap" in found
+    assert "sk_rtw.estimators._selection" in found and "sk_rtw.align" not in found
+    assert found.count("sk_rtw.align._training") == 2  # the import and import_module
+    assert "sk_rtw.estimators._selection.WINDOWS" in found
+    assert not any("dtw" in name for name in found)  # a mention is no import
+
+
+def test_benchmarks_use_the_public_api_but_two_studies():
+    readers = sorted(
+        str(path.relative_to(BENCHMARKS))
+        for path in BENCHMARKS.rglob("*.py")
+        if _private_imports(path)
+    )
+    assert readers == sorted(PRIVATE_READERS)
+    assert all(name.startswith("studies/") for name in PRIVATE_READERS)

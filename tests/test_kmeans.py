@@ -282,7 +282,9 @@ def shifted_bumps(n_per=8, seed=0):
 
 
 def test_an_auto_window_is_chosen_from_the_training_series_and_used_in_the_fit():
-    from sk_rtw.estimators._selection import PRIOR, WINDOWS
+    from sk_rtw import AutoChoice
+
+    PRIOR, WINDOWS = AutoChoice().prior, AutoChoice().windows
 
     X, y = shifted_bumps()
     X_test, y_test = shifted_bumps(seed=1)

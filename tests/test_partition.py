@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from sk_rtw import dtw_pairwise_distance
+from sk_rtw import AutoChoice, dtw_pairwise_distance
 from sk_rtw.estimators import _partition, _selection
 from sk_rtw.utils import check_series_collection
 
@@ -31,7 +31,7 @@ def test_a_sampled_class_is_split_on_its_completed_matrix(monkeypatch):
     monkeypatch.setattr(_selection, "MAX_SERIES", 14)
     X, y = two_shapes_per_class(n=20)
     collection = check_series_collection(X)
-    selection = _selection.choose(collection, y, 0.1, 0.25, random_state=0)
+    selection = _selection.choose(collection, y, 0.1, 0.25, AutoChoice(), random_state=0)
     assert selection.report["sampled"]
     for c in (0, 1):
         members = np.flatnonzero(y == c)

@@ -6,6 +6,7 @@ import pickle
 
 import numpy as np
 import pytest
+from scipy.special import softmax
 from sklearn.base import clone
 from sklearn.linear_model import LinearRegression, LogisticRegression
 from sklearn.model_selection import GridSearchCV, StratifiedKFold
@@ -48,7 +49,7 @@ def test_out_of_fold_distances_are_those_of_centroids_refitted_without_the_fold(
     nc = RTWNearestCentroid(method=DBA(), n_centroids=2, dtw_window=window, random_state=0)
     nc.fit(X, y)
     collection = check_series_collection(X)
-    D = out_of_fold_distances(nc, collection, y, 4, random_state=3)
+    D = out_of_fold_distances(nc._fit_record, list(nc.means_), collection, 4, random_state=3)
     rng = np.random.RandomState(3)
     folds = StratifiedKFold(4, shuffle=True, random_state=rng.randint(2**31 - 1))
     checked_refits = 0
@@ -71,7 +72,8 @@ def test_out_of_fold_distances_are_those_of_centroids_refitted_without_the_fold(
 def test_a_centroid_of_one_series_gets_its_class_mean_distance():
     X, y = three_shape_classes(n_per_class=5)
     nc = RTWNearestCentroid(method=DBA(), n_centroids=1.0, dtw_window=0.1).fit(X, y)
-    D = out_of_fold_distances(nc, check_series_collection(X), y, 5, random_state=0)
+    D = out_of_fold_distances(nc._fit_record, list(nc.means_), check_series_collection(X), 5,
+                              random_state=0)  # fmt: skip
     full = np.array([[dtw_distance(a, b, window=0.1) for b in X] for a in X])
     for i in range(len(X)):
         same = np.flatnonzero((y == y[i]) & (np.arange(len(X)) != i))
@@ -169,7 +171,9 @@ def test_auto_decision_follows_the_cross_validated_scores(readout):
     assert clf.decision_ == ("readout" if z >= 1.0 else "nearest")
     forced = clone(clf).set_params(decision="nearest").fit(X, y)
     np.testing.assert_array_equal(forced.predict(X), forced.centroids_.predict(X))
-    np.testing.assert_allclose(forced.predict_proba(X), forced.centroids_.predict_proba(X))
+    expected = softmax(-forced.centroids_.class_distances(X) / forced.temperature_, axis=1)
+    np.testing.assert_allclose(forced.predict_proba(X), expected)
+    assert forced.centroids_.temperature_ == 1.0  # the composed fit is never written into
 
 
 @pytest.mark.parametrize(
@@ -220,7 +224,8 @@ def test_a_class_of_one_series_gets_the_column_mean():
     X, _ = three_shape_classes(n_per_class=2)
     y = np.arange(len(X))
     nc = RTWNearestCentroid(method=DBA(), n_centroids=1, dtw_window=0.1).fit(X, y)
-    D = out_of_fold_distances(nc, check_series_collection(X), y, 3, random_state=0)
+    D = out_of_fold_distances(nc._fit_record, list(nc.means_), check_series_collection(X), 3,
+                              random_state=0)  # fmt: skip
     full = np.array([[dtw_distance(a, b, window=0.1) for b in X] for a in X])
     others = ~np.eye(len(X), dtype=bool)
     np.testing.assert_allclose(D[others], full[others], rtol=1e-10)
@@ -237,7 +242,8 @@ def test_a_random_state_object_gives_one_reproducible_fit():
                                  random_state=np.random.RandomState(5)).fit(X, y)  # fmt: skip
     seed = clf.centroids_.random_state
     assert isinstance(seed, int)
-    again = out_of_fold_distances(clf.centroids_, check_series_collection(X), y, 3,
+    record = clf.centroids_._fit_record
+    again = out_of_fold_distances(record, list(clf.means_), check_series_collection(X), 3,
                                   random_state=seed)  # fmt: skip
     np.testing.assert_array_equal(again, clf.oof_distances_)
     twin = RTWPrototypeClassifier(method=quick(), n_centroids=2, dtw_window=0.1, cv=3,

@@ -9,8 +9,9 @@ import pytest
 from scipy.special import softmax
 from sklearn.metrics import log_loss
 
-from sk_rtw import RTWAverager, RTWNearestCentroid, dtw_pairwise_distance
+from sk_rtw import AutoChoice, RTWAverager, RTWNearestCentroid, dtw_pairwise_distance
 from sk_rtw.estimators import _selection
+from sk_rtw.estimators._choice import mcnemar
 from sk_rtw.estimators._classifier import fit_temperature
 from sk_rtw.estimators._core import SeriesCentroid
 from sk_rtw.estimators._medoids import held_out_distances, kmedoids
@@ -185,8 +186,8 @@ def test_held_out_scores_match_the_whole_matrix(k, window):
 def test_mcnemar_statistic():
     prior = np.array([1, 1, 0, 0, 1, 0], bool)
     candidate = np.array([1, 0, 1, 1, 1, 1], bool)  # 3 better, 1 worse
-    assert _selection.mcnemar(candidate, prior) == pytest.approx(2 / np.sqrt(4))
-    assert _selection.mcnemar(prior, prior) == 0.0
+    assert mcnemar(candidate, prior) == pytest.approx(2 / np.sqrt(4))
+    assert mcnemar(prior, prior) == 0.0
 
 
 # ------------------------------------------------------------------ the choice
@@ -212,22 +213,22 @@ def test_the_prior_stays_unless_a_candidate_is_clearly_better():
     X, y = shifted_bumps()
     clf = RTWNearestCentroid(method="dba").fit(X, y)
     report = clf.selection_
-    prior = dict(zip(("dtw_window", "n_centroids"), _selection.PRIOR, strict=True))
+    prior = dict(zip(("dtw_window", "n_centroids"), AutoChoice().prior, strict=True))
     assert report["prior"] == prior
     scores = {
         _selection.candidate_key(c["dtw_window"], c["n_centroids"]): c
         for c in report["candidates"]
     }
-    assert len(scores) == len(_selection.WINDOWS) * len(_selection.CENTROIDS)
+    assert len(scores) == len(AutoChoice().windows) * len(AutoChoice().centroids)
     best = max(c["z"] for c in scores.values())
     chosen = _selection.candidate_key(clf.dtw_window_, clf.n_centroids_)
-    if best < _selection.Z_THRESHOLD:
-        assert chosen == _selection.candidate_key(*_selection.PRIOR)
+    if best < AutoChoice().z_threshold:
+        assert chosen == _selection.candidate_key(*AutoChoice().prior)
     else:
         assert scores[chosen]["z"] == best
     # one centroid per class, explicitly: the band is what the data prefer
     one = RTWNearestCentroid(method="dba", n_centroids=1).fit(X, y)
-    assert [c["dtw_window"] for c in one.selection_["candidates"]] == list(_selection.WINDOWS)
+    assert [c["dtw_window"] for c in one.selection_["candidates"]] == list(AutoChoice().windows)
     assert one.dtw_window_ <= 0.1
     X_test, y_test = shifted_bumps(seed=1)
     assert clf.score(X_test, y_test) >= 0.9
@@ -298,7 +299,7 @@ def test_a_large_training_set_is_chosen_on_a_stratified_sample(monkeypatch):
     np.testing.assert_array_equal(np.bincount(clf.centroid_classes_), counts)
     assert report["class_centroids"] == counts.tolist()
     index = _selection.selection_sample(
-        check_series_collection(X), y, _selection.WINDOWS, np.random.RandomState(0)
+        check_series_collection(X), y, AutoChoice().windows, np.random.RandomState(0)
     )
     assert np.all(np.bincount(y[index]) >= 2) and len(np.unique(index)) == len(index)
 
@@ -308,9 +309,9 @@ def test_the_cell_budget_bounds_the_sample():
     collection = check_series_collection(X)
     codes = np.repeat([0, 1], 200)
     index = _selection.selection_sample(
-        collection, codes, _selection.WINDOWS, np.random.RandomState(0)
+        collection, codes, AutoChoice().windows, np.random.RandomState(0)
     )
-    pair = sum(_selection.band_cells(1000, w) for w in _selection.WINDOWS)
+    pair = sum(_selection.band_cells(1000, w) for w in AutoChoice().windows)
     cells = len(index) ** 2 / 2 * pair
     assert cells <= _selection.CELLS_PER_POINT * X.size
     assert len(index) < 400

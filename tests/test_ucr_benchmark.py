@@ -12,10 +12,12 @@ from benchmarks.ucr._data import load_split
 from benchmarks.ucr._protocol import paired_test
 from benchmarks.ucr._summary import HALF_A, HALF_B, HALF_C1, HALF_C2, halves
 from benchmarks.ucr.run import main
-from sk_rtw import RTWNearestCentroid, dtw_pairwise_distance
-from sk_rtw.estimators._selection import CENTROIDS, PRIOR, WINDOWS
+from sk_rtw import AutoChoice, RTWNearestCentroid, dtw_pairwise_distance
 
 from .conftest import UCR_DIR
+
+WINDOWS, CENTROIDS, PRIOR = (AutoChoice().windows, AutoChoice().centroids,
+                             AutoChoice().prior)  # fmt: skip
 
 
 def test_small_run_writes_results_resumes_and_records_failures(tmp_path, capsys):
@@ -318,7 +320,7 @@ def test_default_rows_make_the_same_choice_and_the_halves_report_adds_up(tmp_pat
 def test_the_candidates_benchmark_scores_every_candidate_and_the_prior_rule(tmp_path, capsys):
     """Every candidate is a fixed classifier on the test split; the prior rule picks what
     the estimator's choice picks on the same training series."""
-    from benchmarks.ucr import candidates
+    from benchmarks.studies import candidates
 
     out = tmp_path / "candidates"
     candidates.main(["--data-dir", str(tmp_path), "--datasets", "GunPoint", "ItalyPowerDemand",

@@ -73,7 +73,7 @@ def paper_parser(
 def parse_paper_args(parser: argparse.ArgumentParser, argv=None) -> argparse.Namespace:
     """Parse, then check what argparse cannot (settings, device, the output file) before
     any work."""
-    from sk_rtw._settings import check_device
+    from sk_rtw.align import check_device
 
     args = parser.parse_args(argv)
     if hasattr(args, "options"):
@@ -101,7 +101,6 @@ def add_engine_options(parser: argparse.ArgumentParser) -> None:
 
 def apply_engine_options(args: argparse.Namespace) -> None:
     """Check ``--options`` against the knob table (names and values) before any work."""
-    from sk_rtw._settings import knob_parameter
     from sk_rtw.align import KNOBS
 
     if not isinstance(args.options, dict):
@@ -110,7 +109,7 @@ def apply_engine_options(args: argparse.Namespace) -> None:
         if name not in KNOBS:
             raise SystemExit(f"error: --options: {name!r} is no setting (known: {sorted(KNOBS)})")
         try:
-            knob_parameter(name).check(value)
+            KNOBS[name].with_auto().check(value)
         except ValueError as exc:
             raise SystemExit(f"error: --options: {exc}") from None
     ENGINE_OPTIONS.clear()

@@ -62,13 +62,13 @@ from scipy.special import softmax
 
 from sk_rtw import (
     Alignment,
+    AutoChoice,
     RTWNearestCentroid,
     RTWPrototypeClassifier,
     RTWProximityForest,
     dtw_nearest_distance,
     dtw_pairwise_distance,
 )
-from sk_rtw.estimators._selection import WINDOWS
 from sk_rtw.utils import to_aeon
 
 from .._shared import method_object
@@ -375,14 +375,15 @@ def _fit_1nn_band(train, test, config):
     classes, codes = np.unique(train.y, return_inverse=True)
     start = time.perf_counter()
     scores = {}
-    for window in WINDOWS:
+    windows = AutoChoice().windows  # the default classifier's candidate bands
+    for window in windows:
         held_out = dtw_nearest_distance(
             train.X, train.X, codes, window=window, squared=True,
             exclude=np.arange(len(codes)), nearest_only=True,
         )  # fmt: skip
         scores[window] = float((held_out.argmin(1) == codes).mean())
     best = max(scores.values())
-    window = next(w for w in WINDOWS if scores[w] == best)  # the narrowest of the best
+    window = next(w for w in windows if scores[w] == best)  # the narrowest of the best
     fit_seconds = time.perf_counter() - start
     start = time.perf_counter()
     nearest = dtw_nearest_distance(test.X, train.X, codes, window=window, squared=True,

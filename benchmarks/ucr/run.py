@@ -106,8 +106,7 @@ from benchmarks.ucr._summary import (
     verdict,
 )
 from benchmarks.ucr._tsml import export as export_tsml
-from sk_rtw._settings import check_device
-from sk_rtw.align import PRESETS
+from sk_rtw.align import PRESETS, check_device
 
 
 def parse_args(argv=None) -> argparse.Namespace:

@@ -13,6 +13,7 @@ from ._base import DelegatingClassifier
 if TYPE_CHECKING:
     import torch
 
+    from ..estimators import AutoChoice
     from ..manifolds import Manifold
     from ..methods import AveragingMethod
 
@@ -88,6 +89,7 @@ class RTWClassifier(DelegatingClassifier):
         n_centroids: int | str = "auto",
         dtw_window: float | str | None = "auto",
         representation: str = "raw",
+        choice: AutoChoice | None = None,
         n_jobs: int | None = 1,
         random_state: int | np.random.RandomState | np.random.Generator | None = None,
         device: str | torch.device = "cpu",
@@ -100,6 +102,7 @@ class RTWClassifier(DelegatingClassifier):
         self.n_centroids = n_centroids
         self.dtw_window = dtw_window
         self.representation = representation
+        self.choice = choice
         self.n_jobs = n_jobs
         self.random_state = random_state
         self.device = device

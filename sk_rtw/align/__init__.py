@@ -7,6 +7,7 @@ from .._settings import (
     Knob,
     OutputLength,
     Preset,
+    check_device,
     knobs_markdown,
     presets_markdown,
 )
@@ -27,6 +28,7 @@ __all__ = [
     "Preset",
     "align",
     "align_collection",
+    "check_device",
     "knobs_markdown",
     "presets_markdown",
     "resolve_config",

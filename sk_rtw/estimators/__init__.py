@@ -2,12 +2,14 @@
 classifiers, and a proximity forest."""
 
 from ._averager import NTWAverager, RTWAverager, TTWAverager
+from ._choice import AutoChoice
 from ._classifier import NTWNearestCentroid, RTWNearestCentroid, TTWNearestCentroid
 from ._forest import RTWProximityForest
 from ._kmeans import RTWKMeans
 from ._prototypes import RTWPrototypeClassifier
 
 __all__ = [
+    "AutoChoice",
     "NTWAverager",
     "NTWNearestCentroid",
     "RTWAverager",

@@ -14,10 +14,11 @@ from sklearn.utils.validation import check_is_fitted
 from .._settings import PRESETS
 from ..dtw import dtw_pairwise_distance
 from ..methods import FitContext, get_method
-from ..representations import REPRESENTATIONS, represent, represented_manifold
+from ..representations import represent, represented_manifold
 from ..utils import SeriesCollection, check_series_collection
 from ..utils._params import declare_parameters, validate_parameters
-from ._core import _label, fit_centroids
+from ._choice import DEFAULT_CHOICE, AutoChoice, mcnemar
+from ._core import _label
 from ._params import (
     AVERAGER_DEFAULTS,
     AVERAGER_PARAMETERS,
@@ -26,7 +27,8 @@ from ._params import (
     setting_hint,
 )
 from ._partition import partition
-from ._selection import Z_THRESHOLD, choose, mcnemar
+from ._record import CentroidFitRecord
+from ._selection import choose
 
 if TYPE_CHECKING:
     import torch
@@ -126,6 +128,7 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         n_centroids: int | str = 1,
         dtw_window: float | str | None = None,
         representation: str = "raw",
+        choice: AutoChoice | None = None,
         n_jobs: int | None = None,
         random_state: int | np.random.RandomState | np.random.Generator | None = None,
         device: str | torch.device = "cpu",
@@ -137,6 +140,7 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         self.n_centroids = n_centroids
         self.dtw_window = dtw_window
         self.representation = representation
+        self.choice = choice
         self.n_jobs = n_jobs
         self.random_state = random_state
         self.device = device
@@ -177,14 +181,33 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         self._fit_means(X, y, require_two_classes=False)
         return self
 
-    def _fit_means(self, X, y, require_two_classes):
-        """Validate every parameter, resolve the "auto" choices, fit the means.
+    def _fit_means(self, X, y, require_two_classes) -> CentroidFitRecord:
+        """Validate every parameter, resolve the "auto" choices into the fit's record,
+        fit the centroids from it and set the fitted attributes; returns the record
+        (also kept as ``_fit_record``)."""
+        record, collection = self._plan_fit(X, y, require_two_classes)
+        fits = record.fit(collection)
+        self._fit_record = record
+        self.classes_ = record.classes
+        self.method_ = record.method.label
+        self.representation_ = record.representation
+        self.dtw_window_ = record.dtw_window
+        self.n_centroids_ = record.n_centroids
+        self.selection_ = {} if record.selection is None else record.selection.report
+        self.alignments_ = fits
+        self.centroid_classes_ = np.array(record.owners)
+        self.assignments_ = np.array(record.groups)
+        means = [fit.mean for fit in fits]
+        same_length = len({len(m) for m in means}) == 1
+        self.means_ = np.stack(means) if same_length else means
+        return record
 
-        Returns, when the choice ran, the held-out distance of every series it scored to
-        every class and their classes (``Selection.held_out``), else None.
-        """
+    def _plan_fit(self, X, y, require_two_classes) -> tuple[CentroidFitRecord, SeriesCollection]:
+        """Everything the fit resolves before any centroid is averaged: the record, and
+        the training series in its representation."""
         params = validate_parameters(self)
         method = get_method(params["method"])
+        choice = (DEFAULT_CHOICE if params["choice"] is None else params["choice"]).checked()
         context = FitContext(
             preset=params["preset"], device=params["device"], n_jobs=params["n_jobs"],
             verbose=int(params["verbose"]),
@@ -209,27 +232,24 @@ class RTWAverager(TransformerMixin, BaseEstimator):
                 f"class ({classes.tolist()})"
             )
         window, n_centroids = params["dtw_window"], params["n_centroids"]
-        self.selection_ = {}
         selection = None
         chooses = "auto" in (window, n_centroids) and PRESETS[params["preset"]].chooses
         if representation == "auto" and not chooses:  # nothing is chosen: the series
-            representation, collection = "raw", series
+            representation = choice.representations[0]
+            collection = represent(series, representation)
         if chooses and representation == "auto":
             representation, collection, selection = self._select_representation(
-                series, codes, window, n_centroids, params
+                series, codes, window, n_centroids, choice, params
             )
         elif chooses:
-            selection = self._select(collection, codes, window, n_centroids, params)
+            selection = self._select(collection, codes, window, n_centroids, choice, params)
         if selection is not None:
             window, n_centroids = selection.dtw_window, selection.n_centroids
-            self.selection_ = selection.report
         elif "auto" in (window, n_centroids):  # the paper's protocol: one mean, no band
             window = None if window == "auto" else window
             n_centroids = 1 if n_centroids == "auto" else n_centroids
-        self.representation_ = representation
         context = replace(context, dtw_window=window)
         config = method.configure(context)  # resolved once, with the band chosen
-        owner = type(self).__name__
         if isinstance(n_centroids, int) and n_centroids == 1:
             groups, owners = codes, np.arange(len(classes))
             names, kind = list(classes), "class"
@@ -242,23 +262,15 @@ class RTWAverager(TransformerMixin, BaseEstimator):
             names = [f"{_label(classes[c])}/{r + 1}" for c, r in zip(owners, rank, strict=True)]
             kind = "centroid"
         seeds = check_random_state(self.random_state).randint(2**31 - 1, size=len(owners))
-        fits = fit_centroids(method, config, collection, groups, [int(s) for s in seeds],
-                             context, names=names, kind=kind, owner=owner)  # fmt: skip
-        self.classes_ = classes
-        self.method_ = method.label
-        self.dtw_window_ = window
-        self.n_centroids_ = n_centroids
-        self.alignments_ = fits
-        self.centroid_classes_ = owners
-        self.assignments_ = groups
-        means = [fit.mean for fit in fits]
-        same_length = len({len(m) for m in means}) == 1
-        self.means_ = np.stack(means) if same_length else means
-        if selection is None:
-            return None
-        return selection.held_out, codes[selection.sample]
+        record = CentroidFitRecord.create(
+            method=method, config=config, context=context, representation=representation,
+            dtw_window=window, n_centroids=n_centroids, classes=classes, codes=codes,
+            groups=groups, owners=owners, seeds=seeds, names=names, kind=kind,
+            selection=selection, owner=type(self).__name__,
+        )  # fmt: skip
+        return record, collection
 
-    def _select(self, collection, codes, window, n_centroids, params):
+    def _select(self, collection, codes, window, n_centroids, choice, params):
         """Resolve ``dtw_window="auto"`` and ``n_centroids="auto"`` (see
         :mod:`sk_rtw.estimators._selection`)."""
         if len(np.unique(codes)) < 2:
@@ -267,36 +279,47 @@ class RTWAverager(TransformerMixin, BaseEstimator):
                 "with at least 2 classes (or set n_centroids and dtw_window)"
             )
         return choose(
-            collection, codes, window, n_centroids, random_state=self.random_state,
+            collection, codes, window, n_centroids, choice, random_state=self.random_state,
             n_jobs=params["n_jobs"], verbose=int(params["verbose"]), owner=type(self).__name__,
         )  # fmt: skip
 
-    def _select_representation(self, series, codes, window, n_centroids, params):
-        """``representation="auto"``: the band and the centroids chosen on the series and
-        on their tangent velocity; the velocity only where its choice classifies the
-        held-out series better than the series' choice by :data:`Z_THRESHOLD` standard
-        errors (McNemar, on the series both scored). Returns the representation, the
-        collection in it and its selection (whose report says what the other scored)."""
+    def _select_representation(self, series, codes, window, n_centroids, choice, params):
+        """``representation="auto"``: the band and the centroids chosen on every
+        representation of ``choice.representations``; another than the first only where
+        its choice classifies the held-out series better than the first's by
+        ``choice.z_threshold`` standard errors (McNemar, on the series both scored; the
+        best such). Returns the representation, the collection in it and its selection
+        (whose report says what the others scored)."""
         choices = {}
-        for name in REPRESENTATIONS:
+        for name in choice.representations:
             collection = represent(series, name)
             choices[name] = (collection, self._select(collection, codes, window, n_centroids,
-                                                      params))  # fmt: skip
+                                                      choice, params))  # fmt: skip
         correct = {}
         for name, (_, selection) in choices.items():
             held_out = selection.held_out
             right = held_out.argmin(1) == codes[selection.sample]
             correct[name] = dict(zip(selection.sample.tolist(), right.tolist(), strict=True))
-        common = sorted(set(correct["raw"]) & set(correct["velocity"]))
-        raw = np.array([correct["raw"][i] for i in common], dtype=bool)
-        velocity = np.array([correct["velocity"][i] for i in common], dtype=bool)
-        z = float(mcnemar(velocity, raw))
-        chosen = "velocity" if z >= Z_THRESHOLD else "raw"
+        first, *others = choice.representations
+        chosen, report = first, {"chosen": first}
+        best = -np.inf
+        accuracy = {}
+        for name in others:
+            common = sorted(set(correct[first]) & set(correct[name]))
+            prior = np.array([correct[first][i] for i in common], dtype=bool)
+            candidate = np.array([correct[name][i] for i in common], dtype=bool)
+            z = float(mcnemar(candidate, prior))
+            accuracy[first], accuracy[name] = float(prior.mean()), float(candidate.mean())
+            if choice.prefers(z) and z > best:
+                chosen, best = name, z
+            report.setdefault("z", z)
+            report.setdefault("n_series", len(common))
+        report["chosen"] = chosen
+        if chosen != first:
+            report["z"] = best
+        report["accuracy"] = accuracy
         collection, selection = choices[chosen]
-        selection.report["representation"] = {
-            "chosen": chosen, "z": z, "n_series": len(common),
-            "accuracy": {"raw": float(raw.mean()), "velocity": float(velocity.mean())},
-        }  # fmt: skip
+        selection.report["representation"] = report
         return chosen, collection, selection
 
     def _represented(self, X: Any) -> tuple[SeriesCollection, SeriesCollection]:
@@ -366,6 +389,7 @@ class TTWAverager(RTWAverager):
         n_centroids: int | str = 1,
         dtw_window: float | str | None = None,
         representation: str = "raw",
+        choice: AutoChoice | None = None,
         n_jobs: int | None = None,
         random_state: int | np.random.RandomState | np.random.Generator | None = None,
         device: str | torch.device = "cpu",
@@ -378,6 +402,7 @@ class TTWAverager(RTWAverager):
             n_centroids=n_centroids,
             dtw_window=dtw_window,
             representation=representation,
+            choice=choice,
             n_jobs=n_jobs,
             random_state=random_state,
             device=device,
@@ -411,6 +436,7 @@ class NTWAverager(RTWAverager):
         n_centroids: int | str = 1,
         dtw_window: float | str | None = None,
         representation: str = "raw",
+        choice: AutoChoice | None = None,
         n_jobs: int | None = None,
         random_state: int | np.random.RandomState | np.random.Generator | None = None,
         device: str | torch.device = "cpu",
@@ -423,6 +449,7 @@ class NTWAverager(RTWAverager):
             n_centroids=n_centroids,
             dtw_window=dtw_window,
             representation=representation,
+            choice=choice,
             n_jobs=n_jobs,
             random_state=random_state,
             device=device,

@@ -13,7 +13,7 @@ from sklearn.utils.validation import check_is_fitted
 
 from ..dtw import dtw_nearest_distance
 from ..utils._params import declare_parameters
-from ._averager import RTWAverager, _check_labels, _encode
+from ._averager import RTWAverager
 from ._params import (
     AVERAGER_DEFAULTS,
     AVERAGER_PARAMETERS,
@@ -27,6 +27,7 @@ if TYPE_CHECKING:
 
     from ..manifolds import Manifold
     from ..methods import AveragingMethod
+    from ._choice import AutoChoice
 
 
 def fit_temperature(distances: np.ndarray, labels: np.ndarray) -> float:
@@ -81,16 +82,18 @@ class RTWNearestCentroid(ClassifierMixin, RTWAverager):
     manifold DTW (paper, section V-A, with several centroids per class).
 
     What to set: ``manifold`` for your data, nothing else to start with. By default
-    (``n_centroids="auto", dtw_window="auto"``) ``fit`` chooses the Sakoe-Chiba band (0,
-    0.05, 0.1, 0.2 of the series length, or none) and the centroids of every class (one,
-    or a fraction of the class: 1/8, 1/4, 1/2 or every series) from the training data:
-    every candidate is scored by leave-one-out nearest-medoid classification of the
-    training series, and no band with a quarter of every class as centroids is kept
-    unless the held-out series clearly prefer another candidate (``selection_``). Each
-    class is then split by k-medoids and every part averaged once, so large classes get
-    many centroids and small ones few; prediction finds the nearest centroid with lower
-    bounds and early abandoning (the exhaustive search's answer at a fraction of its
-    cost). The UCR benchmark page of the documentation gives the accuracy, fit and
+    (``n_centroids="auto", dtw_window="auto"``) ``fit`` chooses the Sakoe-Chiba band and
+    the centroids of every class from the training data: every candidate of ``choice``
+    (:class:`~sk_rtw.AutoChoice`) is scored by leave-one-out nearest-medoid
+    classification of the training series, and its prior is kept unless the held-out
+    series clearly prefer another candidate (``selection_``).
+
+    %(choice)s
+
+    Each class is then split by k-medoids and every part averaged once, so large classes
+    get many centroids and small ones few; prediction finds the nearest centroid with
+    lower bounds and early abandoning (the exhaustive search's answer at a fraction of
+    its cost). The UCR benchmark page of the documentation gives the accuracy, fit and
     prediction times measured against 1-NN DTW. One mean per class, as in the paper's
     Table II: ``n_centroids=1, dtw_window=None``; ``preset="paper"`` for the paper's
     exact protocol; ``method="dba"`` for the fastest fit; ``n_centroids=1.0`` for 1-NN
@@ -165,6 +168,7 @@ class RTWNearestCentroid(ClassifierMixin, RTWAverager):
         n_centroids: int | str = "auto",
         dtw_window: float | str | None = "auto",
         representation: str = "raw",
+        choice: AutoChoice | None = None,
         n_jobs: int | None = None,
         random_state: int | np.random.RandomState | np.random.Generator | None = None,
         device: str | torch.device = "cpu",
@@ -177,6 +181,7 @@ class RTWNearestCentroid(ClassifierMixin, RTWAverager):
         self.n_centroids = n_centroids
         self.dtw_window = dtw_window
         self.representation = representation
+        self.choice = choice
         self.n_jobs = n_jobs
         self.random_state = random_state
         self.device = device
@@ -202,20 +207,19 @@ class RTWNearestCentroid(ClassifierMixin, RTWAverager):
             raise ValueError(
                 f"{type(self).__name__} requires y to be passed, but the target y is None"
             )
-        held_out = self._fit_means(X, y, require_two_classes=True)
+        selection = self._fit_means(X, y, require_two_classes=True).selection
         if not isinstance(self.temperature, str):  # "fit" was checked with the others
             self.temperature_ = float(self.temperature)
             return self
-        finite = None if held_out is None else np.isfinite(held_out[0]).all(1)
+        finite = None if selection is None else np.isfinite(selection.held_out).all(1)
         if finite is not None and finite.sum() >= 2:
             # the choice's leave-one-out distances: a centroid that is a training series
             # is at distance 0 from it, which would make the fitted temperature collapse
-            distances, codes = held_out
-            self.temperature_ = fit_temperature(distances[finite], codes[finite])
+            codes = self._fit_record.codes[selection.sample]
+            self.temperature_ = fit_temperature(selection.held_out[finite], codes[finite])
         else:
             distances = self.class_distances(X)
-            _, codes = _encode(_check_labels(y, len(distances), True))
-            self.temperature_ = fit_temperature(distances, codes)
+            self.temperature_ = fit_temperature(distances, self._fit_record.codes)
         return self
 
     def class_distances(self, X: Any) -> np.ndarray:
@@ -326,6 +330,7 @@ class TTWNearestCentroid(RTWNearestCentroid):
         n_centroids: int | str = "auto",
         dtw_window: float | str | None = "auto",
         representation: str = "raw",
+        choice: AutoChoice | None = None,
         n_jobs: int | None = None,
         random_state: int | np.random.RandomState | np.random.Generator | None = None,
         device: str | torch.device = "cpu",
@@ -339,6 +344,7 @@ class TTWNearestCentroid(RTWNearestCentroid):
             n_centroids=n_centroids,
             dtw_window=dtw_window,
             representation=representation,
+            choice=choice,
             n_jobs=n_jobs,
             random_state=random_state,
             device=device,
@@ -373,6 +379,7 @@ class NTWNearestCentroid(RTWNearestCentroid):
         n_centroids: int | str = "auto",
         dtw_window: float | str | None = "auto",
         representation: str = "raw",
+        choice: AutoChoice | None = None,
         n_jobs: int | None = None,
         random_state: int | np.random.RandomState | np.random.Generator | None = None,
         device: str | torch.device = "cpu",
@@ -386,6 +393,7 @@ class NTWNearestCentroid(RTWNearestCentroid):
             n_centroids=n_centroids,
             dtw_window=dtw_window,
             representation=representation,
+            choice=choice,
             n_jobs=n_jobs,
             random_state=random_state,
             device=device,

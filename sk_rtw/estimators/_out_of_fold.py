@@ -4,8 +4,9 @@ A readout trained on the distances of the training series to the fitted centroid
 from values that never occur at prediction time: a series is close to the centroid it
 was averaged into. Here the training series are split into stratified folds; for every
 fold, each centroid that averaged some of the fold's series is refitted on its other
-series (same method, band, seed and settings; every touched centroid of the fold in one
-batched fit), and the fold's series are measured against the centroids of the fit with
+series (the fit's record, :meth:`~sk_rtw.estimators._record.CentroidFitRecord.refit`:
+same method, band, seed and settings; every touched centroid of the fold in one batched
+fit), and the fold's series are measured against the centroids of the fit with
 the refitted ones in their place. A centroid is only refitted without the series of its
 own part, so the columns keep their meaning: column ``m`` is always "centroid ``m``".
 
@@ -27,16 +28,14 @@ from sklearn.model_selection import KFold, StratifiedKFold
 from sklearn.utils import check_random_state
 
 from ..dtw import dtw_pairwise_distance
-from ..methods import FitContext, get_method
 from ..utils import SeriesCollection, check_series_collection
-from ..utils._params import validate_parameters
-from ._core import fit_centroids
+from ._record import CentroidFitRecord
 
 
 def out_of_fold_distances(
-    centroids: Any,
+    record: CentroidFitRecord,
+    means: list[np.ndarray],
     collection: SeriesCollection,
-    codes: np.ndarray,
     n_folds: int,
     *,
     random_state: Any = None,
@@ -46,40 +45,30 @@ def out_of_fold_distances(
 
     Parameters
     ----------
-    centroids : RTWNearestCentroid
-        Fitted on ``collection`` (its ``assignments_``, ``centroid_classes_``, ``means_``,
-        ``dtw_window_`` and method settings are reused).
+    record : CentroidFitRecord
+        The record of the centroid fit (``_fit_record`` of a fitted
+        :class:`RTWNearestCentroid`): its groups, classes, band, method and seeds.
+    means : list of ndarray
+        The fitted centroids (``means_``), entry ``m`` of centroid ``m``.
     collection : SeriesCollection
-        The training series of the fit.
-    codes : ndarray of int, shape (n_series,)
-        Class index of every series.
+        The training series of the fit, in the record's representation.
     n_folds : int
         Stratified folds (at most the size of the largest class).
     random_state : int, RandomState or None
-        Draws the folds. The refits' seeds are drawn from ``centroids.random_state`` as
-        the fit drew them: the same seeds when it is an integer (as
-        :class:`RTWPrototypeClassifier` makes it).
+        Draws the folds. The refits keep the seeds the fit drew (the record's).
     owner : str
         The estimator's name, for the ``verbose`` lines.
 
     Returns
     -------
     distances : ndarray of shape (n_series, n_means)
-        Column ``m`` is the entry ``m`` of ``centroids.means_``.
+        Column ``m`` is the entry ``m`` of ``means``.
     """
-    params = validate_parameters(centroids)
-    method = get_method(params["method"])
-    verbose = int(params["verbose"])
-    context = FitContext(
-        preset=params["preset"], device=params["device"], n_jobs=params["n_jobs"],
-        verbose=max(0, verbose - 1), dtw_window=centroids.dtw_window_,
-    )  # fmt: skip
-    config = method.configure(context)
-    groups = np.asarray(centroids.assignments_, dtype=np.int64)
-    n_means = len(centroids.centroid_classes_)
-    means = list(centroids.means_)
-    # the seeds the fit gave every centroid (RTWAverager._fit_means draws them so)
-    seeds = check_random_state(centroids.random_state).randint(2**31 - 1, size=n_means)
+    verbose = record.context.verbose
+    groups = record.groups
+    codes = record.codes
+    n_means = len(record.owners)
+    means = list(means)
     rng = check_random_state(random_state)
     distances = np.full((collection.n_series, n_means), np.nan)
     start = time.perf_counter()
@@ -88,21 +77,17 @@ def out_of_fold_distances(
         in_fold = np.zeros(collection.n_series, dtype=bool)
         in_fold[test] = True
         touched = np.unique(groups[test])
-        kept = [m for m in touched if np.any((groups == m) & ~in_fold)]
+        kept = np.array([m for m in touched if np.any((groups == m) & ~in_fold)], dtype=np.int64)
         fold_means = list(means)
-        if kept:
+        if len(kept):
             rows = np.flatnonzero(np.isin(groups, kept) & ~in_fold)
-            refit_codes = np.searchsorted(kept, groups[rows])
-            fits = fit_centroids(
-                method, config, collection.subset(rows), refit_codes,
-                [int(seeds[m]) for m in kept], context, kind="centroid", owner=owner,
-            )  # fmt: skip
+            fits = record.refit(collection, rows, kept, verbose=max(0, verbose - 1), owner=owner)
             for m, fit in zip(kept, fits, strict=True):
                 fold_means[m] = fit.mean
         reference = check_series_collection(fold_means, collection.manifold, name="means_")
         distances[test] = dtw_pairwise_distance(
-            collection.subset(test), reference, window=centroids.dtw_window_,
-            n_jobs=params["n_jobs"],
+            collection.subset(test), reference, window=record.dtw_window,
+            n_jobs=record.context.n_jobs,
         )  # fmt: skip
         # a centroid whose every series is in the fold has not been seen without them
         lost = np.setdiff1d(touched, kept)

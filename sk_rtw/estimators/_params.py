@@ -14,8 +14,9 @@ from ..methods._registry import METHODS, method_parameter
 from ..representations import REPRESENTATIONS
 from ..utils._common_params import DTW_WINDOW as BAND
 from ..utils._common_params import MANIFOLD, N_JOBS, RANDOM_STATE, VERBOSE
-from ..utils._constraints import Interval, Options
+from ..utils._constraints import Constant, InstanceOf, Interval, Options
 from ..utils._params import Parameter, doc_indent, indent, wrap
+from ._choice import DEFAULT_CHOICE, AutoChoice
 
 METHOD = method_parameter(
     'Averaging method: "rtw", "ttw", "ntw", "dba" (DTW barycenter averaging with Fréchet '
@@ -57,6 +58,17 @@ REPRESENTATION = Parameter(
     'default because "auto" won 3 points on one half of the UCR development archive and '
     "nothing on three others (UCR page).",
 )
+CHOICE = Parameter(
+    "choice",
+    (
+        Constant(None, "AutoChoice(), the measured default"),
+        InstanceOf("AutoChoice", "an AutoChoice", (AutoChoice,)),
+    ),
+    'What every "auto" value of the estimator chooses from, and the evidence needed to '
+    "leave its prior (sk_rtw.AutoChoice: candidate bands, centroids and representations, "
+    "the prior, z_threshold; searchable as choice__z_threshold, or a list of objects in a "
+    f"grid). The default: {DEFAULT_CHOICE.describe()}.",
+)
 TEMPERATURE = Parameter(
     "temperature",
     (Interval(float, 0.0, closed="neither"), Options(("fit",))),
@@ -83,8 +95,8 @@ TOL = Parameter(
 
 #: The parameters of :class:`RTWAverager`, in signature order, with its defaults.
 AVERAGER_PARAMETERS = (
-    MANIFOLD, METHOD, PRESET_PARAMETER, N_CENTROIDS, DTW_WINDOW, REPRESENTATION, N_JOBS,
-    RANDOM_STATE, DEVICE_PARAMETER, VERBOSE,
+    MANIFOLD, METHOD, PRESET_PARAMETER, N_CENTROIDS, DTW_WINDOW, REPRESENTATION, CHOICE,
+    N_JOBS, RANDOM_STATE, DEVICE_PARAMETER, VERBOSE,
 )  # fmt: skip
 AVERAGER_DEFAULTS = {
     "manifold": "euclidean",
@@ -93,6 +105,7 @@ AVERAGER_DEFAULTS = {
     "n_centroids": 1,
     "dtw_window": None,
     "representation": "raw",
+    "choice": None,
     "n_jobs": None,
     "random_state": None,
     "device": "cpu",
@@ -139,6 +152,8 @@ def set_params_with_hints(estimator, params: dict, set_params) -> None:
 
 #: Where :func:`document_settings` writes the default method's settings.
 SETTINGS_MARKER = "%(method_settings)s"
+#: Where :func:`document_settings` writes the default choice's candidates.
+CHOICE_MARKER = "%(choice)s"
 
 
 def settings_notes(method: str, preset: str, chooses: bool = False) -> str:
@@ -173,4 +188,8 @@ def document_settings(cls):
         notes = settings_notes(defaults["method"], defaults["preset"], chooses)
         block = indent(notes, doc_indent(cls.__doc__, SETTINGS_MARKER))
         cls.__doc__ = cls.__doc__.replace(SETTINGS_MARKER, block.lstrip())
+    if cls.__doc__ and CHOICE_MARKER in cls.__doc__:
+        grid = f"The default candidates (``choice=None``): {DEFAULT_CHOICE.describe()}."
+        block = indent("\n".join(wrap(grid)), doc_indent(cls.__doc__, CHOICE_MARKER))
+        cls.__doc__ = cls.__doc__.replace(CHOICE_MARKER, block.lstrip())
     return cls

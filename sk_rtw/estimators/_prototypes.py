@@ -7,6 +7,7 @@ from numbers import Integral
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from scipy.special import softmax
 from sklearn.base import BaseEstimator, ClassifierMixin, TransformerMixin, clone, is_classifier
 from sklearn.linear_model import RidgeClassifierCV
 from sklearn.pipeline import Pipeline, make_pipeline
@@ -17,7 +18,7 @@ from sklearn.utils.validation import check_is_fitted
 
 from ..utils._constraints import Constant, Interval, Options, Satisfies
 from ..utils._params import Parameter, declare_parameters, validate_parameters
-from ._averager import _check_labels, _encode
+from ._choice import DEFAULT_CHOICE, mcnemar
 from ._classifier import RTWNearestCentroid, fit_temperature
 from ._out_of_fold import fold_count, out_of_fold_distances
 from ._params import (
@@ -28,13 +29,13 @@ from ._params import (
     setting_hint,
 )
 from ._readout_cv import cross_validated_predictions, fit_readout
-from ._selection import Z_THRESHOLD, mcnemar
 
 if TYPE_CHECKING:
     import torch
 
     from ..manifolds import Manifold
     from ..methods import AveragingMethod
+    from ._choice import AutoChoice
 
 
 def _is_classifier(value: Any) -> bool:
@@ -181,8 +182,11 @@ class RTWPrototypeClassifier(ClassifierMixin, TransformerMixin, BaseEstimator):
     Attributes
     ----------
     centroids_ : RTWNearestCentroid
-        The nearest-centroid fit whose centroids are the features (its probability
-        temperature fitted on the out-of-fold distances).
+        The nearest-centroid fit whose centroids are the features (fitted with
+        ``temperature=1.0``; never modified after its fit).
+    temperature_ : float
+        The temperature of the nearest centroid's probabilities
+        (``decision_ == "nearest"``), fitted on the out-of-fold class distances.
     readout_ : classifier
         The fitted readout (a clone of ``readout``), trained on class indices
         ``0..n_classes - 1``.
@@ -241,6 +245,7 @@ class RTWPrototypeClassifier(ClassifierMixin, TransformerMixin, BaseEstimator):
         n_centroids: int | str = "auto",
         dtw_window: float | str | None = "auto",
         representation: str = "raw",
+        choice: AutoChoice | None = None,
         n_jobs: int | None = None,
         random_state: int | np.random.RandomState | np.random.Generator | None = None,
         device: str | torch.device = "cpu",
@@ -255,6 +260,7 @@ class RTWPrototypeClassifier(ClassifierMixin, TransformerMixin, BaseEstimator):
         self.n_centroids = n_centroids
         self.dtw_window = dtw_window
         self.representation = representation
+        self.choice = choice
         self.n_jobs = n_jobs
         self.random_state = random_state
         self.device = device
@@ -300,17 +306,18 @@ class RTWPrototypeClassifier(ClassifierMixin, TransformerMixin, BaseEstimator):
         params = validate_parameters(self)  # every parameter checked before any work
         readout = default_readout() if params["readout"] is None else clone(params["readout"])
         _check_readout_parameters(readout)
-        # one integer seed for the whole fit: the refits then get the seeds the fit drew
-        # and the decision's cross-validation the folds of the out-of-fold distances,
-        # whatever random_state is (an int, None, a RandomState or a Generator)
+        # one integer seed for the whole fit, drawn once from random_state (an int, None,
+        # a RandomState or a Generator): the centroids, the folds of the out-of-fold
+        # distances and the decision's cross-validation follow from it
         seed = self.random_state
         if not isinstance(seed, Integral):
             seed = int(check_random_state(seed).randint(2**31 - 1))
         shared = {name: getattr(self, name) for name in CENTROID_PARAMETERS}
         centroids = RTWNearestCentroid(**{**shared, "random_state": seed}, temperature=1.0)
         centroids.fit(X, y)
+        record = centroids._fit_record
         collection, _ = centroids._represented(X)
-        _, codes = _encode(_check_labels(y, collection.n_series, True))
+        codes = record.codes
         self.n_folds_ = fold_count(params["cv"], codes)
         if self.n_folds_ < params["cv"]:
             warnings.warn(
@@ -319,22 +326,23 @@ class RTWPrototypeClassifier(ClassifierMixin, TransformerMixin, BaseEstimator):
                 UserWarning, stacklevel=2,
             )  # fmt: skip
         distances = out_of_fold_distances(
-            centroids, collection, codes, params["cv"], random_state=seed,
+            record, list(centroids.means_), collection, params["cv"], random_state=seed,
             owner=type(self).__name__,
         )  # fmt: skip
         class_distances = np.stack(
             [distances[:, centroids.centroid_classes_ == c].min(1)
              for c in range(len(centroids.classes_))], axis=1,
         )  # fmt: skip
-        centroids.temperature_ = fit_temperature(class_distances, codes)
+        self.temperature_ = fit_temperature(class_distances, codes)
         positive = distances[distances > 0]
         self.distance_scale_ = float(np.median(positive)) if len(positive) else 1.0
         features = self._features(distances)
         unfitted = clone(readout)
         fit_readout(readout, features, codes)
+        choice = (DEFAULT_CHOICE if params["choice"] is None else params["choice"]).checked()
         self.decision_, self.cv_accuracy_ = self._decide(
             params["decision"], unfitted, readout, features, class_distances, codes,
-            params["cv"], seed,
+            params["cv"], seed, choice,
         )  # fmt: skip
         self.centroids_ = centroids
         self.readout_ = readout
@@ -349,7 +357,7 @@ class RTWPrototypeClassifier(ClassifierMixin, TransformerMixin, BaseEstimator):
         return self
 
     def _decide(self, decision, readout, fitted, features, class_distances, codes, n_folds,
-                seed):  # fmt: skip
+                seed, choice):  # fmt: skip
         """``decision_`` and the cross-validated accuracies behind it: the default
         readout's leave-one-out predictions (closed form, from ``fitted``), any other
         readout refitted on the folds of the out-of-fold distances (drawn from ``seed``
@@ -367,7 +375,7 @@ class RTWPrototypeClassifier(ClassifierMixin, TransformerMixin, BaseEstimator):
             "readout": float(by_readout.mean()), "nearest": float(by_nearest.mean()),
             "z": float(z),
         }  # fmt: skip
-        return ("readout" if z >= Z_THRESHOLD else "nearest"), scores
+        return ("readout" if choice.prefers(z) else "nearest"), scores
 
     def _features(self, distances: np.ndarray) -> np.ndarray:
         return np.log1p(distances / self.distance_scale_)
@@ -409,7 +417,8 @@ class RTWPrototypeClassifier(ClassifierMixin, TransformerMixin, BaseEstimator):
     @available_if(_readout_has("predict_proba"))
     def predict_proba(self, X: Any) -> np.ndarray:
         """Class probabilities: the readout's (where it has them), or the nearest
-        centroid's (``decision_ == "nearest"``: ``centroids_.predict_proba``).
+        centroid's (``decision_ == "nearest"``: the softmax of the negative class
+        distances, ``centroids_.class_distances``, over ``temperature_``).
 
         Parameters
         ----------
@@ -421,7 +430,7 @@ class RTWPrototypeClassifier(ClassifierMixin, TransformerMixin, BaseEstimator):
         """
         check_is_fitted(self, "readout_")
         if self.decision_ == "nearest":
-            return self.centroids_.predict_proba(X)
+            return softmax(-self.centroids_.class_distances(X) / self.temperature_, axis=1)
         return self.readout_.predict_proba(self._features(self.transform(X)))
 
     @available_if(_readout_has("decision_function"))

@@ -8,16 +8,17 @@ rounded up, at least one centroid: :func:`class_counts`), so that a class's cent
 follow its size; ``1.0`` makes every series a centroid (1-NN DTW within the band).
 Everything is computed once and scored many times:
 
-1. one DTW matrix of every class's training series per candidate band (:data:`WINDOWS`);
-2. every candidate (band, centroids of :data:`CENTROIDS`) is scored by leave-one-out
+1. one DTW matrix of every class's training series per candidate band
+   (:class:`~sk_rtw.AutoChoice`'s ``windows``);
+2. every candidate (band, centroids of its ``centroids``) is scored by leave-one-out
    nearest-medoid classification: k-medoids of every class on its matrix; each series'
    distance to its own class is the nearest of that class's medoids, a medoid itself
    left out and replaced in its cluster
    (:func:`~sk_rtw.estimators._medoids.held_out_distances`), and its distance to every
    other class the nearest of their medoids (:func:`~sk_rtw.dtw.dtw_nearest_distance`:
    lower bounds and early abandoning). No centroid is averaged;
-3. the choice is the prior :data:`PRIOR` unless another candidate classifies the
-   held-out series better by at least :data:`Z_THRESHOLD` standard errors of the paired
+3. the choice is its ``prior`` unless another candidate classifies the held-out
+   series better by at least its ``z_threshold`` standard errors of the paired
    difference (McNemar's statistic on the series where exactly one of the two is right);
    ties go to fewer centroids, then to the narrower band.
 
@@ -31,7 +32,7 @@ every class is split into its count of parts
 part once.
 
 Why these values: docs, UCR benchmark ("the default classifier"), measured with
-``benchmarks/ucr/candidates.py`` on half A of the development archive and on half C1 of
+``benchmarks/studies/candidates.py`` on half A of the development archive and on half C1 of
 the large training sets, confirmed on halves B and C2.
 """
 
@@ -47,17 +48,9 @@ from sklearn.utils import check_random_state
 
 from ..dtw import dtw_nearest_distance, dtw_pairwise_distance
 from ..utils import SeriesCollection
+from ._choice import AutoChoice, mcnemar
 from ._medoids import held_out_distances, kmedoids
 
-#: Candidate Sakoe-Chiba radii of ``dtw_window="auto"`` (None: no band).
-WINDOWS: tuple[float | None, ...] = (0.0, 0.05, 0.1, 0.2, None)
-#: Candidate centroids of ``n_centroids="auto"``: one per class, or a fraction of every
-#: class (1.0: every series).
-CENTROIDS: tuple[int | float, ...] = (1, 0.125, 0.25, 0.5, 1.0)
-#: The choice unless the training data clearly prefer another candidate.
-PRIOR: tuple[float | None, int | float] = (None, 0.25)
-#: Standard errors by which a candidate must beat the prior on the held-out series.
-Z_THRESHOLD = 1.0
 #: Most training series the choice is made on (a stratified sample beyond).
 MAX_SERIES = 1000
 #: DTW cells of the choice per sample of the training set (sum of the series lengths):
@@ -152,13 +145,6 @@ def selection_sample(
         members = np.flatnonzero(codes == c)
         keep.append(rng.choice(members, quota, replace=False))
     return np.sort(np.concatenate(keep))
-
-
-def mcnemar(candidate: np.ndarray, prior: np.ndarray) -> float:
-    """Paired difference of two 0/1 outcome vectors in standard errors (McNemar)."""
-    better = int(np.sum(candidate & ~prior))
-    worse = int(np.sum(~candidate & prior))
-    return (better - worse) / np.sqrt(better + worse) if better + worse else 0.0
 
 
 def candidate_key(window: float | None, n_centroids: int | float) -> tuple:
@@ -319,6 +305,7 @@ def choose(
     codes: np.ndarray,
     window: Any,
     n_centroids: Any,
+    choice: AutoChoice,
     *,
     random_state: Any = None,
     n_jobs: int | None = None,
@@ -335,6 +322,8 @@ def choose(
         Class of every series, ``0..n_classes - 1`` (at least two classes).
     window : float, None or "auto"
     n_centroids : int, float or "auto"
+    choice : AutoChoice
+        The candidates and the rule, checked (:meth:`AutoChoice.checked`).
     random_state : int, RandomState or None
         Draws the sample of a large training set.
     n_jobs : int, optional
@@ -349,12 +338,7 @@ def choose(
     Selection
     """
     start = time.perf_counter()
-    windows = WINDOWS if window == "auto" else (window,)
-    counts = CENTROIDS if n_centroids == "auto" else (n_centroids,)
-    prior = (
-        PRIOR[0] if window == "auto" else window,
-        PRIOR[1] if n_centroids == "auto" else counts[0],
-    )
+    windows, counts, prior = choice.candidates(window, n_centroids)
     rng = check_random_state(random_state)
     sample = selection_sample(collection, codes, windows, rng)
     subset = collection.subset(sample)
@@ -385,7 +369,7 @@ def choose(
     statistics = {q: mcnemar(outcomes[q], base) for q in outcomes}
     best = max(statistics.values())
     chosen = prior
-    if best >= Z_THRESHOLD:
+    if choice.prefers(best):
         chosen = min(
             (candidates[q] for q, z in statistics.items() if z >= best - 1e-12),
             key=lambda c: (_centroid_order(c[1]), _width(c[0])),
@@ -399,7 +383,7 @@ def choose(
         "criterion": (
             "leave-one-out nearest-medoid accuracy on the training series; the prior "
             f"(dtw_window={prior[0]}, n_centroids={prior[1]}) unless a candidate is better "
-            f"by at least {Z_THRESHOLD} standard errors (McNemar)"
+            f"by at least {choice.z_threshold} standard errors (McNemar)"
         ),
         "prior": {"dtw_window": prior[0], "n_centroids": prior[1]},
         "candidates": [

@@ -11,12 +11,12 @@ test accuracy of the candidate each picks, against 1-NN DTW with squared point c
 no band (the predictions of aeon's ``KNeighborsTimeSeriesClassifier``, computed here with
 sk_rtw's exact nearest-neighbour search): fixed candidates, the best leave-one-out score,
 and priors kept unless a candidate is better by ``z`` standard errors (the default's
-rule, :mod:`sk_rtw.estimators._selection`).
+rule, :class:`sk_rtw.AutoChoice`).
 
 Example::
 
-    python benchmarks/ucr/candidates.py --data-dir ../shared/ucr --all --methods rtw dba
-    python benchmarks/ucr/candidates.py --data-dir ../shared/ucr_large \\
+    python benchmarks/studies/candidates.py --data-dir ../shared/ucr --all --methods rtw dba
+    python benchmarks/studies/candidates.py --data-dir ../shared/ucr_large \\
         --datasets Crop Computers AllGestureWiimoteX --methods dba
 
 Per-dataset results go to ``--out`` (default ``results/candidates``, one JSON file each,
@@ -39,16 +39,17 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the repository; 
 from benchmarks._shared import check_writable, existing_directory
 from benchmarks.ucr._data import available_datasets, load_split
 from benchmarks.ucr._summary import halves
-from sk_rtw import RTWNearestCentroid, dtw_nearest_distance, dtw_pairwise_distance
-from sk_rtw.estimators._selection import (
-    CENTROIDS,
-    WINDOWS,
+from sk_rtw import AutoChoice, RTWNearestCentroid, dtw_nearest_distance, dtw_pairwise_distance
+from sk_rtw.estimators._selection import (  # the choice's own steps, one by one
     class_partitions,
     held_out_scores,
     mcnemar,
     selection_sample,
 )
 from sk_rtw.utils import check_series_collection
+
+#: The default candidates (the grid a rule picks from).
+WINDOWS, CENTROIDS = AutoChoice().windows, AutoChoice().centroids
 
 
 def key(window, k) -> str:

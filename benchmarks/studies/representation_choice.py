@@ -2,7 +2,7 @@
 
 Usage::
 
-    python benchmarks/ucr/representation_choice.py --data-dir ../shared/ucr --halves A B \
+    python benchmarks/studies/representation_choice.py --data-dir ../shared/ucr --halves A B \
         --seeds 0 1 2 --out results/representation_choice.jsonl
 
 For every dataset and seed, ``RTWNearestCentroid(representation="auto",
@@ -27,13 +27,13 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the repository
 
-from benchmarks.ucr._data import load_split
-from benchmarks.ucr._halves_cli import (
+from benchmarks.studies._halves_cli import (
     halves_parser,
     measure_missing,
     print_half_means,
     read_records,
 )
+from benchmarks.ucr._data import load_split
 from sk_rtw import RTWNearestCentroid
 
 

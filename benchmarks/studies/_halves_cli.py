@@ -1,7 +1,7 @@
 """The command line and the record file shared by the per-half UCR studies
-(``prototype_decision.py``, ``prototype_features.py``, ``series_features.py``): a data
-directory, fixed halves, seeds, and JSON lines appended one dataset at a time, so that a
-rerun skips what is there."""
+(``forest_measures.py``, ``representation_choice.py``): a data directory, fixed halves,
+seeds, and JSON lines appended one dataset at a time, so that a rerun skips what is
+there."""
 
 from __future__ import annotations
 

@@ -2,8 +2,8 @@
 
 Usage::
 
-    python benchmarks/ucr/forest_measures.py --data-dir ../shared/ucr --halves A --seeds 0 1 2 \
-        --variants default exponents-1-2 --out results/forest_measures.jsonl
+    python benchmarks/studies/forest_measures.py --data-dir ../shared/ucr --halves A \
+        --seeds 0 1 2 --variants default exponents-1-2 --out results/forest_measures.jsonl
 
 For every dataset, seed and variant, :class:`sk_rtw.RTWProximityForest(random_state=seed,
 n_jobs=1)` is fitted on one thread with its measure family changed as the variant says,
@@ -30,13 +30,13 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the repository
 
-from benchmarks.ucr._data import load_split
-from benchmarks.ucr._halves_cli import (
+from benchmarks.studies._halves_cli import (
     halves_parser,
     measure_missing,
     print_half_means,
     read_records,
 )
+from benchmarks.ucr._data import load_split
 from sk_rtw import RTWProximityForest
 from sk_rtw.estimators import _proximity_split
 
