@@ -16,7 +16,7 @@ import numpy as np
 from sklearn.base import BaseEstimator
 
 from ..representations import REPRESENTATIONS
-from ..utils._constraints import Interval, InvalidParameterError, Satisfies
+from ..utils._constraints import InvalidParameterError, Satisfies
 from ..utils._params import Parameter, declare_parameters, validate_parameters
 
 
@@ -84,6 +84,12 @@ _PRIOR = Satisfies(
 _REPRESENTATIONS = Satisfies(
     "sequence of str", f"distinct names of {REPRESENTATIONS}", predicate=_is_representations
 )
+_THRESHOLD = Satisfies(
+    "float",
+    "a number, inf included (not NaN)",
+    predicate=lambda v: isinstance(v, Real) and not isinstance(v, (bool, np.bool_))
+    and not np.isnan(v),
+)
 CHOICE_PARAMETERS = (
     Parameter(
         "windows",
@@ -106,9 +112,9 @@ CHOICE_PARAMETERS = (
     ),
     Parameter(
         "z_threshold",
-        (Interval(float, None, None, closed="neither"),),
+        (_THRESHOLD,),
         "Standard errors by which a candidate must beat the prior on the held-out series "
-        "(McNemar's statistic); a large value keeps the prior.",
+        "(McNemar's statistic); ``inf`` always keeps the prior.",
     ),
     Parameter(
         "representations",
