@@ -6,20 +6,20 @@ from unittest import mock
 
 import numpy as np
 import pytest
-from sklearn.base import clone
 from sklearn.linear_model import LogisticRegression, Ridge, RidgeClassifierCV, _ridge
 from sklearn.pipeline import make_pipeline
 from sklearn.preprocessing import LabelBinarizer, StandardScaler
+from sklearn.utils.estimator_checks import parametrize_with_checks
 
 from sk_rtw.estimators._out_of_fold import split_folds
 from sk_rtw.estimators._prototypes import default_readout
 from sk_rtw.estimators._readout_cv import (
     cross_validated_predictions,
-    fit_readout,
     is_default_readout,
     ridge_loo_predictions,
     ridge_loo_scores,
 )
+from sk_rtw.estimators._ridge_readout import RidgeGCVClassifier
 
 
 def noisy_features(rng, n, p, k):
@@ -78,32 +78,43 @@ def test_other_readouts_are_refitted_on_the_folds(rng):
 
 @pytest.mark.parametrize(("n", "p", "k"), [(120, 15, 3), (60, 6, 2)], ids=["three", "two"])
 def test_default_readout_fit_by_svd_equals_the_covariance_fit(n, p, k, rng):
+    """RidgeGCVClassifier is RidgeClassifierCV's fit (its default, covariance mode, up to
+    rounding: the same penalty and predictions) by one SVD of the features."""
     features, codes = noisy_features(rng, n, p, k)
     features = np.abs(features) + features[:, :1] ** 2  # correlated, uneven scales
-    plain = default_readout().fit(features, codes)
+    plain = make_pipeline(StandardScaler(), RidgeClassifierCV(alphas=np.logspace(-3, 3, 13)))
+    plain.fit(features, codes)
     svd = _ridge._RidgeGCV._svd_decompose_design_matrix
     with mock.patch.object(_ridge._RidgeGCV, "_svd_decompose_design_matrix", autospec=True,
                            side_effect=svd) as spy:  # fmt: skip
-        fitted = fit_readout(default_readout(), features, codes)
-    assert spy.call_count == 1  # scikit-learn still honours the mode
+        fitted = default_readout().fit(features, codes)
+    assert spy.call_count == 1  # one SVD for every penalty
+    assert isinstance(fitted[-1], RidgeGCVClassifier)
     assert fitted[-1].alpha_ == plain[-1].alpha_
     np.testing.assert_allclose(fitted[-1].coef_, plain[-1].coef_, rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(fitted[-1].intercept_, plain[-1].intercept_, atol=1e-12)
     np.testing.assert_allclose(fitted[-1].best_score_, plain[-1].best_score_, rtol=1e-9)
+    scores = fitted.decision_function(features), plain.decision_function(features)
+    np.testing.assert_allclose(*scores, rtol=1e-9, atol=1e-12)
     np.testing.assert_array_equal(fitted.predict(features), plain.predict(features))
-    # the mode is no parameter: clone and repr show the readout the user gave
-    assert "gcv_mode" not in fitted[-1].get_params()
-    assert repr(fitted) == repr(plain)
-    assert not hasattr(clone(fitted)[-1], "gcv_mode") or clone(fitted)[-1].gcv_mode is None
+    assert fitted[-1].coef_.shape == plain[-1].coef_.shape
 
 
-def test_other_readouts_and_wide_features_fit_as_given(rng):
+def test_wide_features_take_ridge_cvs_own_mode(rng):
     features, codes = noisy_features(rng, 20, 40, 3)  # more features than series
     with mock.patch.object(_ridge._RidgeGCV, "_svd_decompose_design_matrix") as spy:
-        fitted = fit_readout(default_readout(), features, codes)
-        weighted = make_pipeline(StandardScaler(), RidgeClassifierCV(class_weight="balanced"))
-        long_features, long_codes = noisy_features(rng, 80, 5, 3)
-        fit_readout(weighted, long_features, long_codes)
+        fitted = default_readout().fit(features, codes)
     spy.assert_not_called()
-    assert getattr(fitted[-1], "gcv_mode", None) is None
-    assert getattr(weighted[-1], "gcv_mode", None) is None
+    plain = make_pipeline(StandardScaler(), RidgeClassifierCV(alphas=np.logspace(-3, 3, 13)))
+    expected = plain.fit(features, codes).decision_function(features)
+    np.testing.assert_array_equal(fitted.decision_function(features), expected)
+
+
+def test_the_ridge_readout_needs_two_classes():
+    with pytest.raises(ValueError, match="2 classes"):
+        RidgeGCVClassifier().fit(np.ones((4, 2)), [0, 0, 0, 0])
+
+
+@parametrize_with_checks([RidgeGCVClassifier()])
+def test_the_ridge_readout_is_a_scikit_learn_classifier(estimator, check):
+    check(estimator)

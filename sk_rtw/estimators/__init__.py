@@ -7,6 +7,7 @@ from ._classifier import NTWNearestCentroid, RTWNearestCentroid, TTWNearestCentr
 from ._forest import RTWProximityForest
 from ._kmeans import RTWKMeans
 from ._prototypes import RTWPrototypeClassifier
+from ._ridge_readout import RidgeGCVClassifier
 
 __all__ = [
     "AutoChoice",
@@ -17,6 +18,7 @@ __all__ = [
     "RTWNearestCentroid",
     "RTWPrototypeClassifier",
     "RTWProximityForest",
+    "RidgeGCVClassifier",
     "TTWAverager",
     "TTWNearestCentroid",
 ]

@@ -9,7 +9,6 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from scipy.special import softmax
 from sklearn.base import BaseEstimator, ClassifierMixin, TransformerMixin, clone, is_classifier
-from sklearn.linear_model import RidgeClassifierCV
 from sklearn.pipeline import Pipeline, make_pipeline
 from sklearn.preprocessing import StandardScaler
 from sklearn.utils import check_random_state
@@ -28,7 +27,8 @@ from ._params import (
     set_params_with_hints,
     setting_hint,
 )
-from ._readout_cv import cross_validated_predictions, fit_readout
+from ._readout_cv import cross_validated_predictions
+from ._ridge_readout import RidgeGCVClassifier
 
 if TYPE_CHECKING:
     import torch
@@ -58,8 +58,9 @@ READOUT = Parameter(
     ),
     "Classifier fitted on the features log(1 + d / s) of the out-of-fold distances d to "
     "every centroid (s: their median, ``distance_scale_``); cloned in fit. None: "
-    "StandardScaler then RidgeClassifierCV (alphas 1e-3..1e3), a linear readout "
-    "(``readout_weights_``).",
+    "StandardScaler then sk_rtw.estimators.RidgeGCVClassifier (alphas 1e-3..1e3: "
+    "RidgeClassifierCV's fit, by scikit-learn's faster SVD mode where the series "
+    "outnumber the centroids), a linear readout (``readout_weights_``).",
 )
 DECISION = Parameter(
     "decision",
@@ -87,7 +88,7 @@ CENTROID_PARAMETERS = tuple(p.name for p in AVERAGER_PARAMETERS)
 def default_readout() -> Pipeline:
     """The readout of ``readout=None``: standardised features, ridge-regularised linear
     classifier with its penalty chosen by efficient leave-one-out."""
-    return make_pipeline(StandardScaler(), RidgeClassifierCV(alphas=np.logspace(-3, 3, 13)))
+    return make_pipeline(StandardScaler(), RidgeGCVClassifier(alphas=np.logspace(-3, 3, 13)))
 
 
 def _check_readout_parameters(readout: Any) -> None:
@@ -338,7 +339,7 @@ class RTWPrototypeClassifier(ClassifierMixin, TransformerMixin, BaseEstimator):
         self.distance_scale_ = float(np.median(positive)) if len(positive) else 1.0
         features = self._features(distances)
         unfitted = clone(readout)
-        fit_readout(readout, features, codes)
+        readout.fit(features, codes)
         choice = (DEFAULT_CHOICE if params["choice"] is None else params["choice"]).checked()
         self.decision_, self.cv_accuracy_ = self._decide(
             params["decision"], unfitted, readout, features, class_distances, codes,

@@ -1,16 +1,10 @@
 """The default readout of a prototype classifier: its fit, and its cross-validated
 predictions for the choice of the decision.
 
-The default readout (standardised features, then ``RidgeClassifierCV``) is linear
-least squares with a ridge penalty. scikit-learn chooses its penalty by the leave-one-out
-errors of every candidate (generalised cross-validation); for more series than features
-``RidgeClassifierCV`` does so in its covariance mode, which forms the hat matrix's
-diagonal with an ``n p^2`` product per candidate penalty (13 of them by default), and it
-has no ``gcv_mode`` parameter to choose otherwise (``RidgeCV`` has). :func:`fit_readout`
-asks the same estimator for scikit-learn's SVD mode instead: one SVD of the features,
-then ``O(n p)`` per penalty; the same penalty and weights up to rounding, in half the
-time on a feature matrix of ElectricDevices' size (8,926 series, 2,234 centroids): 29
-against 14 s on one thread.
+The default readout (standardised features, then
+:class:`~sk_rtw.estimators._ridge_readout.RidgeGCVClassifier`, ``RidgeClassifierCV``'s
+fit) is linear least squares with a ridge penalty chosen by the leave-one-out errors of
+every candidate (generalised cross-validation).
 
 Its leave-one-out predictions follow from the fitted model in closed form (Allen's
 PRESS; Golub, Heath and Wahba 1979): with the hat matrix
@@ -35,33 +29,27 @@ from sklearn.pipeline import Pipeline
 from sklearn.preprocessing import LabelBinarizer, StandardScaler
 
 from ._out_of_fold import split_folds
+from ._ridge_readout import RidgeGCVClassifier
 
 
 def is_default_readout(readout: Any) -> bool:
-    """Whether ``readout`` is standardisation then ``RidgeClassifierCV`` with an intercept,
-    unweighted: the readout whose left-out predictions have a closed form."""
+    """Whether ``readout`` is standardisation then a ridge classifier chosen by
+    generalised cross-validation (:class:`RidgeGCVClassifier`, or ``RidgeClassifierCV``
+    with an intercept, unweighted): the readouts whose left-out predictions have a
+    closed form."""
     if not isinstance(readout, Pipeline) or len(readout.steps) != 2:
         return False
     scaler, ridge = readout.steps[0][1], readout.steps[1][1]
+    if type(scaler) is not StandardScaler or not scaler.with_mean:
+        return False
+    if type(ridge) is RidgeGCVClassifier:
+        return True
     return (
-        type(scaler) is StandardScaler
-        and scaler.with_mean
-        and type(ridge) is RidgeClassifierCV
+        type(ridge) is RidgeClassifierCV
         and ridge.fit_intercept
         and ridge.class_weight is None
         and ridge.cv is None
     )
-
-
-def fit_readout(readout: Any, features: np.ndarray, codes: np.ndarray) -> Any:
-    """Fit ``readout`` on ``features`` and ``codes``; the default readout with more series
-    than features by scikit-learn's SVD mode of generalised cross-validation (module
-    docstring): the same fit up to rounding. Returns ``readout``, fitted."""
-    if is_default_readout(readout) and features.shape[0] > features.shape[1]:
-        # RidgeClassifierCV.fit reads the attribute as RidgeCV does its parameter; it is
-        # not a parameter of the classifier, so clone, get_params and repr never see it
-        readout.steps[1][1].gcv_mode = "svd"
-    return readout.fit(features, codes)
 
 
 def ridge_loo_predictions(readout: Pipeline, features: np.ndarray, codes: np.ndarray):
@@ -80,8 +68,8 @@ def ridge_loo_scores(readout: Pipeline, features: np.ndarray, codes: np.ndarray)
     Parameters
     ----------
     readout : Pipeline
-        ``StandardScaler`` then ``RidgeClassifierCV``, fitted on ``features`` and ``codes``
-        (:func:`is_default_readout`).
+        ``StandardScaler`` then ``RidgeGCVClassifier`` (or ``RidgeClassifierCV``), fitted
+        on ``features`` and ``codes`` (:func:`is_default_readout`).
     features : ndarray of shape (n_series, n_features)
     codes : ndarray of int, shape (n_series,)
 
