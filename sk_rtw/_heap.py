@@ -1,13 +1,14 @@
 """Large temporaries without a page fault per element: glibc's heap kept for them.
 
-An epoch of a long alignment allocates dozens of temporaries of the same size
-(``N x Z x point size`` doubles: 64 MB for 8 quaternion series at ``Z = 256,000``).
-glibc's ``malloc`` serves every block above its mmap threshold (at most 32 MB, and a
-block of the size last freed is above it) with a fresh ``mmap`` and returns it with
-``munmap`` when freed, so each temporary's pages are faulted in and zeroed again: a
-multiplication of two such tensors takes 3-5x the time it takes in reused memory
-(``benchmarks/heap_reuse.py``), and RTW's time per epoch grew 8.2x for 4x the length
-from 64,000 to 256,000 samples (2.4 to 19.2 s; 1.6 to 7.5 s, 4.8x, with the heap kept).
+An epoch of a long alignment allocates dozens of temporaries of the same size (``N x Z x
+point size`` doubles: 64 MB for 8 quaternion series at ``Z = 256,000``). glibc's
+``malloc`` serves every block above its mmap threshold (at most 32 MB, and a block of
+the size last freed is above it) with a fresh ``mmap`` and returns it with ``munmap``
+when freed, so each temporary's pages are faulted in and zeroed again: a multiplication
+of two such tensors takes 3-5x the time it takes in reused memory (the retired study
+``heap_reuse.py``, docs/benchmarks/studies.md), and RTW's time per epoch grew 8.2x for
+4x the length from 64,000 to 256,000 samples (2.4 to 19.2 s; 1.6 to 7.5 s, 4.8x, with
+the heap kept).
 
 :func:`heap_for_temporaries` keeps such blocks in the heap for the duration of a
 fit (``M_MMAP_MAX = 0``, trimming off: ``M_TRIM_THRESHOLD = -1``; the largest positive
@@ -22,6 +23,14 @@ alignment of 8 quaternion series rose from 6.0 to 9.3-9.9 GB (the engine keeps t
 where twice its estimated peak fits in the free memory). The settings are
 the process's: fits that overlap (threads of a grid search) share them, set by the first
 to start and given back by the last to finish.
+
+Why the process keeps fixed thresholds after such a fit, instead of its own: glibc can
+neither be asked for its current thresholds nor told to adapt them again once one is set
+(``mallopt(3)``: setting any of the mmap or trim parameters turns the dynamic threshold
+off for the life of the process), so nothing here could restore the state before the
+fit. What it leaves is where that adaptive rule ends anyway for a program that frees
+blocks of 32 MB or more -- and the fit just did, many times. Fits of smaller
+temporaries, and every platform other than glibc, never touch the allocator.
 """
 
 from __future__ import annotations

@@ -215,3 +215,31 @@ def test_benchmarks_use_the_public_api_but_two_studies():
     )
     assert readers == sorted(PRIVATE_READERS)
     assert all(name.startswith("studies/") for name in PRIVATE_READERS)
+
+
+def _function_level_imports(path: Path) -> list[str]:
+    """The package's own modules a file imports inside a function (relative imports, or
+    ``sk_rtw...``)."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    found = []
+    for function in ast.walk(tree):
+        if not isinstance(function, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            continue
+        for node in ast.walk(function):
+            own = isinstance(node, ast.ImportFrom) and (
+                node.level or (node.module or "").startswith("sk_rtw")
+            )  # fmt: skip
+            own = own or (
+                isinstance(node, ast.Import) and node.names[0].name.startswith("sk_rtw")
+            )  # fmt: skip
+            if own:
+                found.append(f"{path.relative_to(ROOT.parent)}:{node.lineno}")
+    return found
+
+
+def test_no_function_level_import_of_the_package():
+    """Every import of the package's own modules is at the top of its module, where the
+    graph above sees it: a function-level import hides a circle or a primitive that
+    sits too high."""
+    hidden = [hit for path in MODULES.values() for hit in _function_level_imports(path)]
+    assert hidden == []

@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 import numpy as np
 
 from ..estimators import RTWNearestCentroid
+from ..methods import DBA, RTW
 from ..utils._params import declare_parameters
 from ._base import DelegatingClassifier
 
@@ -113,8 +114,6 @@ class RTWClassifier(DelegatingClassifier):
     @classmethod
     def _get_test_params(cls, parameter_set: str = "default") -> dict | list[dict]:
         """Fast settings for aeon's estimator checks: few epochs, a fixed seed."""
-        from ..methods import DBA, RTW
-
         return [
             {"method": RTW(n_epochs=2), "random_state": 0},
             {"method": DBA(max_iter=2), "n_centroids": 1, "dtw_window": 0.1},

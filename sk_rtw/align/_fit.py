@@ -162,7 +162,6 @@ def _refined(problem: Problem, collection: SeriesCollection, layout: GroupLayout
     warps series onto its reference), those aligned series, and the loss at the refined
     mean. Returns ``(mean, warps, aligned, costs)`` as the forward pass does."""
     config, manifold = problem.config, collection.manifold
-    band = -1.0 if config.dtw_window is None else float(config.dtw_window)
     means = mean.cpu().numpy().copy()
     warps = np.empty((layout.n_series, output_length(config)))
     for g in range(layout.n_groups):
@@ -171,7 +170,7 @@ def _refined(problem: Problem, collection: SeriesCollection, layout: GroupLayout
         means[g] = refine_mean(series, means[g], manifold, steps=config.refine_steps,
                                window=config.dtw_window).mean  # fmt: skip
         for i, s in zip(members, series, strict=True):
-            path, _ = path_indices(means[g], s, manifold, band)
+            path, _ = path_indices(means[g], s, manifold, config.dtw_window)
             warps[i] = path_warp(path, len(means[g]), len(s), smoothing=0.0)  # exact path
     device = problem.data.device
     refined = torch.as_tensor(means, dtype=torch.float64, device=device)

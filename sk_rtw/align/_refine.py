@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 import torch
 
-from ..dtw import dtw_pairwise_distance, point_cost_matrix, soft_dtw_batch
+from ..dtw import check_window, dtw_pairwise_distance, point_cost_matrix, soft_dtw_batch
 from ..manifolds import Manifold
 from ..manifolds._mean import frechet_mean
 
@@ -91,7 +91,7 @@ def refine_mean(
     -------
     Refinement
     """
-    band = -1.0 if window is None else float(window)
+    band = check_window(window)  # the kernels' convention (-1: no band)
     best = np.asarray(mean, dtype=np.float64)
     start_cost = best_cost = _hard_cost(series, best, manifold, window)
     done = 0

@@ -22,9 +22,10 @@ group follows exactly the trajectory of a separate fit. Per group the loop keeps
   the start, the loss is back near it within a few epochs (generated warped sets: under
   1.71 times by the 8th epoch, then 2-5 % below the start after 20-50 epochs); where it
   is not back, training has not beaten the start on any recorded history (long
-  demonstrations: still 2-100 times after 20 epochs). ``benchmarks/start_patience.py``
-  replays recorded histories under other patiences and ratios: shorter patiences or a
-  ratio of 2 cut training on the generated sets that it would have won.
+  demonstrations: still 2-100 times after 20 epochs). The study ``start_patience.py``
+  (retired: docs/benchmarks/studies.md) replayed recorded histories under other
+  patiences and ratios: shorter patiences or a ratio of 2 cut training on the generated
+  sets that it would have won.
   A group hovering near its start is left to ``n_iter_no_change``.
   A group still *far* from its start stops sooner: one whose lowest loss after
   :data:`EARLY_PATIENCE` epochs is more than :data:`FAR_FROM_START` times the start's

@@ -76,15 +76,16 @@ def check_costs(
     )
 
 
-def optimal_path(cost: np.ndarray, window: float = -1.0) -> tuple[np.ndarray, float]:
+def optimal_path(cost: np.ndarray, window: float | None = None) -> tuple[np.ndarray, float]:
     """Optimal DTW path through a point-cost matrix, and its accumulated cost.
 
     Parameters
     ----------
     cost : ndarray of shape (T_x, T_y)
         Point costs.
-    window : float, default=-1
-        Sakoe–Chiba radius as a fraction of the shorter series; negative: no band.
+    window : float or None, default=None
+        Sakoe–Chiba radius as a fraction of the shorter series; None (or a negative
+        number, what :func:`check_window` returns for None): no band.
 
     Returns
     -------
@@ -92,6 +93,7 @@ def optimal_path(cost: np.ndarray, window: float = -1.0) -> tuple[np.ndarray, fl
         Index pairs ``(i, j)`` from ``(0, 0)`` to ``(T_x - 1, T_y - 1)``.
     cost : float
     """
+    window = -1.0 if window is None else float(window)
     D = _kernels.accumulated_cost(cost, window)
     if not np.isfinite(D[-1, -1]):
         if window < 0.0 or not np.isfinite(cost).all():

@@ -16,7 +16,7 @@ def path_indices(
     x: np.ndarray,
     y: np.ndarray,
     manifold: Manifold,
-    window: float = -1.0,
+    window: float | None = None,
     squared: bool = False,
     guide: np.ndarray | None = None,
 ) -> tuple[np.ndarray, float]:
@@ -27,8 +27,9 @@ def path_indices(
     x : ndarray of shape (T_x, *point_shape)
     y : ndarray of shape (T_y, *point_shape)
     manifold : Manifold
-    window : float, default=-1
-        Sakoe–Chiba radius (fraction of the shorter series); negative: no band.
+    window : float or None, default=None
+        Sakoe–Chiba radius (fraction of the shorter series); None (or a negative number,
+        what :func:`check_window` returns for None): no band.
     squared : bool, default=False
         Squared geodesic point costs.
     guide : ndarray of shape (P', 2), int, optional
@@ -43,6 +44,7 @@ def path_indices(
     path : ndarray of shape (P, 2), int
     cost : float
     """
+    window = -1.0 if window is None else float(window)  # the kernels' "no band"
     if _point_costs.segment_codes(manifold) is None:
         return optimal_path(point_cost_matrix(x, y, manifold, squared), window)
     bound = guide_bound(x, y, manifold, window, squared, guide)
@@ -80,8 +82,9 @@ def mean_matched_positions(
         The reference of each series.
     manifold : Manifold
         One with compiled point costs (:func:`has_compiled_costs`).
-    window : float, default=-1
-        Sakoe–Chiba radius (fraction of the shorter series); negative: no band.
+    window : float or None, default=None
+        Sakoe–Chiba radius (fraction of the shorter series); None (or a negative number,
+        what :func:`check_window` returns for None): no band.
     squared : bool, default=True
         Squared geodesic point costs.
 

@@ -10,7 +10,8 @@ from __future__ import annotations
 from dataclasses import replace
 
 from .._settings import DEVICE_PARAMETER, PRESET_PARAMETER, owners, settings_table
-from ..methods._registry import METHODS, method_parameter
+from ..methods import METHODS, get_method
+from ..methods._registry import method_parameter
 from ..representations import REPRESENTATIONS
 from ..utils._common_params import DTW_WINDOW as BAND
 from ..utils._common_params import MANIFOLD, N_JOBS, RANDOM_STATE, VERBOSE
@@ -134,8 +135,6 @@ def set_params_with_hints(estimator, params: dict, set_params) -> None:
     ``method="rtw"``): the name becomes its object, every setting ``"auto"``, which is
     what the name stands for; a keyword that is no parameter says where it belongs.
     """
-    from ..methods import get_method
-
     nested = any(key.startswith("method__") for key in params)
     if nested and "method" not in params and isinstance(getattr(estimator, "method", None), str):
         estimator.method = get_method(estimator.method)

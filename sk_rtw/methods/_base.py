@@ -25,7 +25,7 @@ from .._settings import ENGINE_METHODS, method_knobs, owners
 from ..manifolds import Manifold
 from ..utils import SeriesCollection
 from ..utils._constraints import AUTO
-from ..utils._params import validate_parameters
+from ..utils._params import declare_parameters, validate_parameters
 
 
 @runtime_checkable
@@ -226,8 +226,6 @@ def method_class(method: str, summary: str):
     """Class decorator: an :class:`AveragingMethod` named ``method`` whose parameters are
     its knobs, every one ``"auto"`` by default (checked against the written
     ``__init__``); the docstring is ``summary`` and the knobs' documentation."""
-    from ..utils._params import declare_parameters
-
     knobs = [knob.with_auto() for knob in method_knobs(method)]
     decorate = declare_parameters(
         knobs, dict.fromkeys((k.name for k in knobs), AUTO), positional=0,
