@@ -217,7 +217,7 @@ def test_invalid_normalize_and_bad_series():
 
 def test_product_without_kernel_distance_uses_general_path():
     from sk_rtw.dtw._point_costs import segment_codes
-    from sk_rtw.dtw._spd_kernels import MAX_KERNEL_SIZE
+    from sk_rtw.manifolds._spd_pairs import MAX_KERNEL_SIZE
 
     k = MAX_KERNEL_SIZE + 1
     M = Product((Sphere(2), SPD(k)))  # no kernel form beyond MAX_KERNEL_SIZE

@@ -1,4 +1,4 @@
-"""SPD distances in the DTW kernels (sk_rtw.dtw._spd_kernels) against independent
+"""SPD distances in the DTW kernels (sk_rtw.manifolds._spd_pairs) against independent
 references: 50-digit arithmetic, the torch geometry, the exhaustive search."""
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ from numba import njit
 from sk_rtw import dtw_distance, dtw_nearest_distance, dtw_pairwise_distance
 from sk_rtw.dtw._kernels import final_cost
 from sk_rtw.dtw._point_costs import kernel_points, segment_codes
-from sk_rtw.dtw._spd_kernels import spd_squared_distance
+from sk_rtw.manifolds._spd_pairs import spd_squared_distance
 from sk_rtw.manifolds import SPD, Euclidean, Product
 
 
@@ -153,7 +153,7 @@ def test_a_point_without_a_cholesky_factor_is_refused_clearly(k):
 def test_kernel_sizes_end_at_max_kernel_size():
     """Up to MAX_KERNEL_SIZE an SPD block has a kernel form (code 3 + k - 2); beyond it
     the manifold's own pairwise distance is used, with the same DTW."""
-    from sk_rtw.dtw._spd_kernels import MAX_KERNEL_SIZE
+    from sk_rtw.manifolds._spd_pairs import MAX_KERNEL_SIZE
 
     largest, beyond = SPD(MAX_KERNEL_SIZE), SPD(MAX_KERNEL_SIZE + 1)
     assert segment_codes(largest).tolist() == [[0, MAX_KERNEL_SIZE * (MAX_KERNEL_SIZE + 2),

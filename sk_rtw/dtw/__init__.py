@@ -16,11 +16,13 @@ for many searches on the calling thread (:func:`nearest_group`, and
 :func:`mean_diagonal_cost`, the scale of amerced DTW's penalty).
 
 The modules stand on floors, each importing only those below it: the compiled point
-costs (``_spd_kernels``, ``_point_costs``); the compiled recursion (``_kernels``, and
-``_pruned`` with the point costs inside it; ``_soft``); point-cost matrices and the
-optimal path through them (``_costs``); the coarse-to-fine band (``_band``); paths
-between series (``_paths``); the distances (``_dtw``); their consumers (``_medoid``,
-``_search``); prepared series for many searches (``_prepared``).
+costs (``_point_costs``, rows of costs from the manifolds' point geometry, which is the
+table :mod:`sk_rtw.manifolds._point_kernels`: no module here names a manifold); the
+compiled recursion (``_kernels``, and ``_pruned`` with the point costs inside it;
+``_soft``); point-cost matrices and the optimal path through them (``_costs``); the
+coarse-to-fine band (``_band``); paths between series (``_paths``); the distances
+(``_dtw``); their consumers (``_medoid``, ``_search``); prepared series for many
+searches (``_prepared``).
 """
 
 from ._band import coarse_collection, multiscale_path, solved_exactly

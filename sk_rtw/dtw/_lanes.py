@@ -10,8 +10,8 @@ at the throughput of the vector units instead of the latency of one chain.
 Every lane performs, for its pair, the operations of the one-pair kernels
 (:func:`~._point_costs._cost_row`, :func:`~._kernels._cell`) in the same order, so the
 distances are those of :func:`~._pruned.pairwise_segments` bit for bit. Only point
-distances made of Euclidean segments are computed in lanes (their cost is a few
-instructions; a sphere's or an SPD matrix's cost dominates its cell anyway).
+distances made of flat segments (squared coordinate differences) are computed in lanes
+(their cost is a few instructions; any other segment's cost dominates its cell anyway).
 
 :func:`lane_blocks` groups the references: equal lengths together, blocks of
 :data:`WIDE` (then :data:`NARROW`) lanes; lengths shared by fewer than :data:`MIN_RUN`
@@ -28,7 +28,7 @@ import numpy as np
 from numba import njit, prange
 
 from ._kernels import sakoe_chiba_rows
-from ._point_costs import _HUGE, _TINY, SEGMENT_EUCLIDEAN, _robust_distance
+from ._point_costs import _HUGE, _TINY, FLAT, robust_distance
 from ._pruned import pruned_distance
 
 _INF = np.inf
@@ -53,14 +53,14 @@ BLOCK_BYTES = 128 * 2**20
 
 
 def lanes_apply(segments: np.ndarray, n_pairs: int, max_length: int) -> bool:
-    """Whether the lanes compute these pairs: Euclidean segments only, enough pairs, and
+    """Whether the lanes compute these pairs: flat segments only, enough pairs, and
     blocks of at most :data:`BLOCK_BYTES` for references of ``max_length`` samples."""
     point_size = int(segments[:, 1].max())
     block = 8 * WIDE * (max_length + 1) * (point_size + 2)
     return (
         n_pairs >= MIN_PAIRS
         and block <= BLOCK_BYTES
-        and bool(np.all(segments[:, 2] == SEGMENT_EUCLIDEAN))
+        and bool(np.all(segments[:, 2] == FLAT))
     )
 
 
@@ -132,7 +132,7 @@ def _amerced_step(prev, left, c, lane, cost, penalty):
 @njit(cache=True, nogil=True, inline="always")
 def _segment_costs(xr, yb, Y, c, refs, first, segments, squared, cost, lanes):
     """Point costs of ``xr`` to column ``c`` of every lane, as :func:`_cost_row` computes
-    them for Euclidean segments (the same sums in the same order, the same fallback)."""
+    them for flat segments (the same sums in the same order, the same fallback)."""
     for lane in range(lanes):
         cost[lane] = 0.0
     for s in range(segments.shape[0]):
@@ -150,7 +150,7 @@ def _segment_costs(xr, yb, Y, c, refs, first, segments, squared, cost, lanes):
     for lane in range(lanes):
         if extreme and (cost[lane] < _TINY or cost[lane] > _HUGE):
             j = refs[lane] if refs[lane] >= 0 else first
-            cost[lane] = _robust_distance(xr, Y[j, c], segments)
+            cost[lane] = robust_distance(xr, Y[j, c], segments)
         else:
             cost[lane] = math.sqrt(cost[lane])
 

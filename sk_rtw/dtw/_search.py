@@ -11,12 +11,10 @@ every pair; :func:`nearest_by_class` computes the same values with far fewer cel
    the query samples that may be matched with it), and the distance of every reference
    sample to that envelope. Every column is on the warping path, and a point's cost to
    any query sample of its band is at least its distance to the envelope, so the sum
-   bounds DTW from below. On a sphere the bound on the chord is turned into one on the
-   angle (``2 asin(c / 2)``, increasing); on quaternions the smaller of the bounds of
-   ``q`` and ``-q`` is taken; on SPD matrices the bound is that of the sorted
-   log-eigenvalues, a 1-Lipschitz map of the affine-invariant distance
-   (:mod:`~sk_rtw.dtw._spd_kernels`); product spaces combine their factors' bounds as
-   their distances are combined.
+   bounds DTW from below. Each segment of a point turns its gap to the envelope into a
+   bound on its own distance (the manifolds' table,
+   :func:`~sk_rtw.manifolds._point_kernels.box_squared_bound`); segments combine their
+   bounds as their distances are combined.
 2. References are visited in increasing order of their bound; one whose bound exceeds
    the best distance found so far for its class is skipped, and the search stops once
    no bound left can beat any class. When only the nearest class is wanted (an argmin:
@@ -56,6 +54,7 @@ from numba import njit, prange
 
 from .._numba import numba_threads, serial_build
 from ..manifolds import Manifold
+from ..manifolds._point_kernels import box_squared_bound, outside
 from ..utils import SeriesCollection, check_series_collection
 from . import _kernels, _point_costs, _pruned
 from ._dtw import check_warp_penalty, check_window, dtw_pairwise_distance
@@ -65,9 +64,6 @@ _INF = np.inf
 #: A reference is skipped when its bound exceeds the best distance so far by this
 #: relative margin or more (the bound and the distance are rounded differently).
 LB_SLACK = 1e-12
-#: An SPD block's bound (its points' log-eigenvalues, each computed to a relative
-#: accuracy of about 1e-16 times the condition number) is shrunk by this factor.
-SPD_BOUND_SHRINK = 1.0 - 1e-6
 
 
 @njit(cache=True, nogil=True)
@@ -130,16 +126,6 @@ def _envelope(x, ny, window, lower, upper, scratch):
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _outside(value, low, high):
-    """Distance of ``value`` to the interval ``[low, high]``."""
-    if value > high:
-        return value - high
-    if value < low:
-        return low - value
-    return 0.0
-
-
-@njit(cache=True, nogil=True, inline="always")
 def _box_cost(point, lower, upper, segments, squared, root):
     """A lower bound of the point cost between ``point`` (``(p,)``, kernel form) and any
     point whose coordinates lie in ``[lower, upper]`` (module docstring: the gap to the
@@ -147,30 +133,11 @@ def _box_cost(point, lower, upper, segments, squared, root):
     roots of the distances, an increasing function of them too)."""
     n_segments = segments.shape[0]
     if _univariate(segments):
-        return _gap_cost(_outside(point[0], lower[0], upper[0]), squared, root)
+        return _gap_cost(outside(point[0], lower[0], upper[0]), squared, root)
     sq = 0.0
     for s in range(n_segments):
-        start, stop, code = segments[s, 0], segments[s, 1], segments[s, 2]
-        near = 0.0
-        if code >= _point_costs.SEGMENT_SPD2:  # the sorted log-eigenvalues
-            stop = start + _point_costs.spd_size(code)
-        for k in range(start, stop):
-            gap = _outside(point[k], lower[k], upper[k])
-            near += gap * gap
-        if code == _point_costs.SEGMENT_EUCLIDEAN:
-            sq += near
-            continue
-        if code >= _point_costs.SEGMENT_SPD2:
-            sq += near * SPD_BOUND_SHRINK
-            continue
-        if code == _point_costs.SEGMENT_SIGN_INVARIANT_SPHERE:
-            flipped = 0.0  # the envelope of -x is [-upper, -lower]
-            for k in range(start, stop):
-                gap = _outside(point[k], -upper[k], -lower[k])
-                flipped += gap * gap
-            near = min(near, flipped)
-        angle = 2.0 * math.asin(min(1.0, 0.5 * math.sqrt(near)))
-        sq += angle * angle
+        sq += box_squared_bound(point, lower, upper, segments[s, 0], segments[s, 1],
+                                segments[s, 2])  # fmt: skip
     near = sq if squared else math.sqrt(sq)
     return math.sqrt(near) if root else near
 
@@ -182,7 +149,7 @@ def lb_keogh(y, lower, upper, segments, squared, root=False):
     total = 0.0
     if _univariate(segments):  # one coordinate: the gap itself, in a tight loop
         for j in range(y.shape[0]):
-            total += _gap_cost(_outside(y[j, 0], lower[j, 0], upper[j, 0]), squared, root)
+            total += _gap_cost(outside(y[j, 0], lower[j, 0], upper[j, 0]), squared, root)
         return total
     for j in range(y.shape[0]):
         total += _box_cost(y[j], lower[j], upper[j], segments, squared, root)
@@ -194,7 +161,7 @@ def _univariate(segments):
     """Whether the point is one Euclidean coordinate."""
     return (
         segments.shape[0] == 1
-        and segments[0, 2] == _point_costs.SEGMENT_EUCLIDEAN
+        and segments[0, 2] == _point_costs.FLAT
         and segments[0, 1] == 1
     )
 

@@ -165,6 +165,24 @@ def _exp_backward_rows(P, V, grad, gp, gv):  # pragma: no cover
             gv[i, j] = sinc * grad[i, j] + coef * V[i, j]
 
 
+@njit(cache=True, nogil=True, inline="always")
+def angle(p, X, j, start, stop, sign_invariant):  # pragma: no cover
+    """The geodesic distance between the unit vectors ``p[start:stop]`` (a 1-D array)
+    and ``x = X[j, start:stop]`` (a row of a 2-D array, read in place):
+    ``atan2(|x - c p|, c)`` with ``c = <p, x>`` (``|c|`` for the sign-invariant distance
+    of unit quaternions), the torch formula's. The one compiled form of the sphere's
+    distance: :func:`_dist_rows` and the DTW point costs (:mod:`._point_kernels`) both
+    call it."""
+    c = 0.0
+    for k in range(start, stop):
+        c += p[k] * X[j, k]
+    sq = 0.0
+    for k in range(start, stop):
+        u = X[j, k] - c * p[k]
+        sq += u * u
+    return math.atan2(math.sqrt(sq), abs(c) if sign_invariant else c)
+
+
 @njit(inline="always", **_OPTIONS)
 def _dist_terms(P, X, i, sign_invariant):  # pragma: no cover
     """``(c, |c| or c, s^2)`` of the torch formula (``u`` with the signed ``c``)."""
@@ -177,9 +195,9 @@ def _dist_terms(P, X, i, sign_invariant):  # pragma: no cover
 
 
 def _dist_rows(P, X, out, sign_invariant):  # pragma: no cover
+    k = P.shape[1]
     for i in prange(P.shape[0]):
-        _, cc, sq = _dist_terms(P, X, i, sign_invariant)
-        out[i] = math.atan2(math.sqrt(sq) if sq > 0.0 else sq * 0.0, cc)
+        out[i] = angle(P[i], X, i, 0, k, sign_invariant)
 
 
 def _dist_backward_rows(P, X, grad, gp, gx, sign_invariant):  # pragma: no cover

@@ -1,5 +1,5 @@
-"""Affine-invariant SPD distances for the DTW kernels: closed forms for 2 x 2 and 3 x 3,
-compiled Householder and QL up to ``MAX_KERNEL_SIZE``.
+"""Affine-invariant SPD distances between prepared points, for the DTW kernels: closed
+forms for 2 x 2 and 3 x 3, compiled Householder and QL up to ``MAX_KERNEL_SIZE``.
 
 ``dist(A, B)^2 = sum_i log(lambda_i)^2`` over the eigenvalues of ``M = L^-1 B L^-T``
 (``A = L L^T``, Cholesky), the generalized eigenvalues of ``(B, A)``: no matrix function
@@ -26,9 +26,10 @@ A flat SPD(k) point is ``k * k`` row-major entries; its features are, in order, 
 ascending log-eigenvalues, the ``k (k + 1) / 2`` entries of ``L^-1`` row by row (lower
 triangle) and the ``k (k + 1) / 2`` entries of the point row by row (upper triangle).
 
-The functions here are inlined into :mod:`sk_rtw.dtw._kernels`, whose numba cache does
-not follow a change in this module: after editing it, delete the ``*.nbi`` / ``*.nbc``
-files under ``sk_rtw/dtw/__pycache__`` (a clean checkout or an installed release has none).
+The functions here are inlined into the DTW kernels (:mod:`sk_rtw.dtw._kernels` and
+the modules beside it, through :mod:`._point_kernels`), whose numba cache does not follow
+a change in this module: after editing it, delete the ``*.nbi`` / ``*.nbc`` files under
+``sk_rtw/dtw/__pycache__`` (a clean checkout or an installed release has none).
 """
 
 from __future__ import annotations
