@@ -243,3 +243,55 @@ def test_no_function_level_import_of_the_package():
     sits too high."""
     hidden = [hit for path in MODULES.values() for hit in _function_level_imports(path)]
     assert hidden == []
+
+
+MANIFOLD_WORDS = ("sphere", "spd", "quaternion", "euclidean")  # (a pose is their product)
+
+
+def _names_in_code(path: Path) -> set[str]:
+    """Every identifier a module's code uses or defines (names, attributes, imports,
+    functions, arguments): its docstrings, comments and strings left out."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    names = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Name):
+            names.add(node.id)
+        elif isinstance(node, ast.Attribute):
+            names.add(node.attr)
+        elif isinstance(node, (ast.FunctionDef, ast.ClassDef)):
+            names.add(node.name)
+        elif isinstance(node, ast.arg):
+            names.add(node.arg)
+        elif isinstance(node, ast.alias):
+            names.update(node.name.split("."))
+        elif isinstance(node, ast.ImportFrom) and node.module:
+            names.update(node.module.split("."))
+    return names
+
+
+def test_the_dtw_package_names_no_manifold():
+    """dtw/ runs recursions over point costs; every manifold's geometry, its compiled
+    point distances and bounds included, is the manifolds' (their table,
+    ``sk_rtw.manifolds._point_kernels``, is all dtw/ reads of it)."""
+    named = {
+        f"{module}: {name}"
+        for module, path in MODULES.items() if module.startswith("sk_rtw.dtw")
+        for name in _names_in_code(path)
+        if any(word in name.lower() for word in MANIFOLD_WORDS)
+    }  # fmt: skip
+    assert named == set()
+    reads = {
+        target for module, targets in GRAPH.items() if module.startswith("sk_rtw.dtw")
+        for target in targets if target.startswith("sk_rtw.manifolds")
+    }  # fmt: skip
+    assert reads <= {"sk_rtw.manifolds", "sk_rtw.manifolds._point_kernels"}
+
+
+def test_the_name_finder_sees_code_not_prose(tmp_path):
+    module = tmp_path / "m.py"
+    module.write_text(
+        '"""On a sphere."""\nfrom ._spd_kernels import f\nSEGMENT_SPHERE = 1\n'
+        'def g(manifold="euclidean"):\n    return x.quaternion\n'
+    )
+    named = {n for n in _names_in_code(module) if any(w in n.lower() for w in MANIFOLD_WORDS)}
+    assert named == {"_spd_kernels", "SEGMENT_SPHERE", "quaternion"}

@@ -10,8 +10,8 @@ from numba import njit
 from sk_rtw import dtw_distance, dtw_nearest_distance, dtw_pairwise_distance
 from sk_rtw.dtw._kernels import final_cost
 from sk_rtw.dtw._point_costs import kernel_points, segment_codes
-from sk_rtw.manifolds._spd_pairs import spd_squared_distance
 from sk_rtw.manifolds import SPD, Euclidean, Product
+from sk_rtw.manifolds._spd_pairs import spd_squared_distance
 
 
 @njit(cache=False)

@@ -5,7 +5,7 @@ from ._check import ManifoldCheckError, check_manifold
 from ._compiled import compiled_maps
 from ._euclidean import Euclidean
 from ._product import Product
-from ._registry import ManifoldSpec, available_manifolds, get_manifold
+from ._registry import ManifoldSpec, available_manifolds, get_manifold, register_manifold
 from ._spd import SPD
 from ._sphere import Quaternion, Sphere
 
@@ -22,4 +22,5 @@ __all__ = [
     "check_manifold",
     "compiled_maps",
     "get_manifold",
+    "register_manifold",
 ]

@@ -90,8 +90,65 @@ _REGISTRY: dict[str, ManifoldSpec] = {
         ),
     ]
 }
+#: The names the package ships (never replaced by :func:`register_manifold`).
+_BUILT_IN = frozenset(_REGISTRY)
 #: Spaces with one dimension only, and that dimension (S^3; 3 + 3 for R^3 x S^3).
 _FIXED_DIMENSION = {"quaternion": 3, "pose": 6}
+
+
+def register_manifold(spec: ManifoldSpec, *, replace: bool = False) -> None:
+    """Give a manifold of your own a name: ``manifold="name"`` then works wherever a
+    built-in name does (``get_manifold``, the DTW functions, ``align``, the estimators).
+
+    A new space is one file -- a :class:`Manifold` subclass with ``point_shape``,
+    ``_exp`` and ``_log`` (:func:`check_manifold` tests it) -- plus this registration.
+    Its DTW runs on its own ``pairwise_dist`` (derived from ``_log`` unless overridden);
+    where its distance is made of the kinds the compiled kernels know
+    (``distance_segments``: "euclidean", "sphere", "sign-invariant sphere", "spd"), the
+    kernels compute it, with lower bounds for the nearest-neighbour search.
+
+    Parameters
+    ----------
+    spec : ManifoldSpec
+        Its name (lower case), a factory from a dimension (``None`` for a space of one
+        dimension), how to read the dimension from a point shape, and a description.
+    replace : bool, default=False
+        Replace a name registered earlier (never a built-in one).
+
+    Raises
+    ------
+    TypeError
+        ``spec`` is no ManifoldSpec, or its factory or reader is not callable.
+    ValueError
+        The name is empty, not lower case, or taken.
+
+    Examples
+    --------
+    >>> from sk_rtw.manifolds import Euclidean, ManifoldSpec, register_manifold
+    >>> plane = ManifoldSpec("plane", lambda d: Euclidean(2),
+    ...                      lambda shape: 2 if shape == (2,) else None, "R^2")
+    >>> register_manifold(plane)  # doctest: +SKIP
+    >>> get_manifold("plane", point_shape=(2,))  # doctest: +SKIP
+    Euclidean(dim=2)
+    """
+    if not isinstance(spec, ManifoldSpec):
+        raise TypeError(f"register_manifold needs a ManifoldSpec, got {type(spec).__name__}")
+    if not callable(spec.factory) or not callable(spec.dim_from_point_shape):
+        raise TypeError(
+            f"ManifoldSpec {spec.name!r}: factory and dim_from_point_shape must be callable"
+        )
+    if not isinstance(spec.name, str) or not spec.name or spec.name != spec.name.lower():
+        raise ValueError(
+            f"a manifold's name must be a non-empty lower-case str, got {spec.name!r}"
+        )
+    if spec.name in _BUILT_IN:
+        raise ValueError(f"{spec.name!r} is a built-in manifold; choose another name")
+    if spec.name in _REGISTRY and not replace:
+        raise ValueError(
+            f"a manifold named {spec.name!r} is registered already; pass replace=True to "
+            "replace it"
+        )
+    _REGISTRY[spec.name] = spec
 
 
 def available_manifolds() -> dict[str, ManifoldSpec]:
