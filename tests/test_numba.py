@@ -6,6 +6,7 @@ import os
 import subprocess
 import sys
 import textwrap
+from pathlib import Path
 
 import pytest
 
@@ -205,3 +206,29 @@ def test_the_serial_and_threaded_builds_of_a_kernel_have_their_own_cache_entries
         result = run_python(code, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
         assert result.returncode == 0, result.stderr[-2000:]
         assert result.stdout.split()[-2:] == ["1", "2"], result.stdout
+
+
+def test_stale_kernel_caches_are_dropped(tmp_path):
+    """An index older than a source the kernels inline is removed; a newer one stays."""
+    from sk_rtw._numba_cache import drop_stale_caches
+
+    cache = tmp_path / "__pycache__"
+    cache.mkdir()
+    old, new, data = cache / "m.f-1.py311.nbi", cache / "m.g-9.py311.nbi", cache / "m.f-1.nbc"
+    source = tmp_path / "inlined.py"
+    for path in (old, new, data, source):
+        path.write_text("x")
+    os.utime(old, (1000, 1000))
+    os.utime(source, (2000, 2000))
+    os.utime(new, (3000, 3000))
+    assert drop_stale_caches(tmp_path, [source]) == 1
+    assert not old.exists() and new.exists() and data.exists()
+    assert drop_stale_caches(tmp_path / "nowhere", [source]) == 0
+
+
+def test_the_dtw_kernels_follow_the_point_geometry_they_inline():
+    from sk_rtw.manifolds import _point_kernels, _spd_pairs, _sphere_kernels
+
+    sources = {Path(p).name for p in _point_kernels.compiled_sources()}
+    assert sources == {Path(m.__file__).name for m in (_point_kernels, _spd_pairs,
+                                                        _sphere_kernels)}  # fmt: skip

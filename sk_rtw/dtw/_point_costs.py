@@ -12,10 +12,13 @@ costs of given paths and of the diagonal alignment.
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 from numba import njit, prange
 
+from .._numba_cache import drop_stale_caches
+from ..manifolds import _point_kernels
 from ..manifolds._point_kernels import (
     FLAT,
     add_squared_distances,
@@ -23,6 +26,10 @@ from ..manifolds._point_kernels import (
     robust_distance,
     segment_codes,
 )
+
+# this package's kernels inline the manifolds' point geometry: compiled afresh after an
+# edit there (numba itself watches only each kernel's own file)
+drop_stale_caches(Path(__file__).parent, _point_kernels.compiled_sources())
 
 __all__ = ["FLAT", "kernel_points", "kernel_series", "robust_distance", "segment_codes"]
 

@@ -35,6 +35,7 @@ import math
 import numpy as np
 from numba import njit
 
+from . import _spd_pairs, _sphere_kernels
 from ._base import Manifold
 from ._spd_pairs import MAX_KERNEL_SIZE, feature_width, spd_features, spd_squared_distance
 from ._sphere_kernels import angle
@@ -51,6 +52,12 @@ _SPD_BLOCKS = {k * k: (SPD2 + k - 2, k) for k in range(2, MAX_KERNEL_SIZE + 1)}
 #: An SPD block's bound (its points' log-eigenvalues, each computed to a relative
 #: accuracy of about 1e-16 times the condition number) is shrunk by this factor.
 SPD_BOUND_SHRINK = 1.0 - 1e-6
+
+
+def compiled_sources() -> list[str]:
+    """The files whose compiled code the DTW kernels inline: this table and the kernel
+    modules of the manifolds it reads (their caches follow an edit of any of them)."""
+    return [__file__, _spd_pairs.__file__, _sphere_kernels.__file__]
 
 
 @njit(cache=True, nogil=True, inline="always")

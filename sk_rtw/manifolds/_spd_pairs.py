@@ -28,8 +28,9 @@ triangle) and the ``k (k + 1) / 2`` entries of the point row by row (upper trian
 
 The functions here are inlined into the DTW kernels (:mod:`sk_rtw.dtw._kernels` and
 the modules beside it, through :mod:`._point_kernels`), whose numba cache does not follow
-a change in this module: after editing it, delete the ``*.nbi`` / ``*.nbc`` files under
-``sk_rtw/dtw/__pycache__`` (a clean checkout or an installed release has none).
+a change in this module by itself: :mod:`sk_rtw.dtw._point_costs` drops the DTW
+package's cached kernels when this file (or the table, or the sphere's kernels) is newer
+(:func:`sk_rtw._numba_cache.drop_stale_caches`).
 """
 
 from __future__ import annotations
