@@ -8,6 +8,7 @@ prototype classifier's ``decision="auto"`` all ask it, and nothing else holds a 
 
 from __future__ import annotations
 
+import math
 from fractions import Fraction
 from numbers import Integral, Real
 from typing import Any
@@ -88,7 +89,7 @@ _THRESHOLD = Satisfies(
     "float",
     "a number, inf included (not NaN)",
     predicate=lambda v: isinstance(v, Real) and not isinstance(v, (bool, np.bool_))
-    and not np.isnan(v),
+    and not math.isnan(float(v)),
 )
 CHOICE_PARAMETERS = (
     Parameter(

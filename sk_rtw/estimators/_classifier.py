@@ -212,7 +212,7 @@ class RTWNearestCentroid(ClassifierMixin, RTWAverager):
             self.temperature_ = float(self.temperature)
             return self
         finite = None if selection is None else np.isfinite(selection.held_out).all(1)
-        if finite is not None and finite.sum() >= 2:
+        if selection is not None and finite is not None and finite.sum() >= 2:
             # the choice's leave-one-out distances: a centroid that is a training series
             # is at distance 0 from it, which would make the fitted temperature collapse
             codes = self._fit_record.codes[selection.sample]

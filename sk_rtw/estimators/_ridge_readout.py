@@ -70,7 +70,8 @@ class RidgeGCVClassifier(ClassifierMixin, BaseEstimator):
         non-empty sequence of positive finite numbers."""
         alphas = np.asarray(self.alphas, dtype=object).ravel()
         if alphas.size == 0 or not all(
-            isinstance(a, Real) and not isinstance(a, bool) and 0 < a < np.inf for a in alphas
+            isinstance(a, Real) and not isinstance(a, bool) and 0 < float(a) < np.inf
+            for a in alphas
         ):
             raise ValueError(
                 f"{type(self).__name__}: alphas must be positive finite numbers; "
