@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from sklearn.utils import check_random_state as _sklearn_check_random_state
 
 RANDOM_STATE_TYPES = "None, an int in [0, 2**32 - 1], a numpy RandomState or a Generator"
 
@@ -31,3 +32,14 @@ def check_generator(random_state=None) -> np.random.Generator:
     if isinstance(random_state, np.random.RandomState):
         return np.random.default_rng(random_state.randint(np.iinfo(np.int32).max))
     return np.random.default_rng(random_state)
+
+
+def check_random_state(random_state=None) -> np.random.RandomState:
+    """scikit-learn's ``check_random_state`` (None: numpy's global ``RandomState``; an int:
+    a new one seeded with it; a ``RandomState``: itself), plus a ``Generator``: a new
+    ``RandomState`` seeded by one draw from it (so a Generator is consumed, as a
+    ``RandomState`` is)."""
+    check_random_state_value(random_state)
+    if isinstance(random_state, np.random.Generator):
+        return np.random.RandomState(int(random_state.integers(0, 2**32)))
+    return _sklearn_check_random_state(random_state)

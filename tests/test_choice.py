@@ -168,3 +168,20 @@ def test_an_averager_with_y_none_records_one_class():
     X, _ = two_shapes_per_class()
     averager = RTWAverager(method=quick("dba")).fit(X)
     assert averager._fit_record.kind == "class" and len(averager._fit_record.owners) == 1
+
+
+STREAMS = {"Generator": lambda: np.random.default_rng(5),
+           "RandomState": lambda: np.random.RandomState(5)}  # fmt: skip
+
+
+@pytest.mark.parametrize("make", STREAMS.values(), ids=STREAMS.keys())
+def test_any_declared_random_state_type_fits_reproducibly(make):
+    """A Generator (declared, and once refused by scikit-learn's check_random_state) or
+    a RandomState: the fit runs and twin streams give the same fit."""
+    X, y = two_shapes_per_class()
+    common = {"method": quick("dba"), "n_centroids": 2, "dtw_window": 0.1}
+    a, b = (RTWPrototypeClassifier(**common, cv=3, random_state=make()).fit(X, y)
+            for _ in range(2))  # fmt: skip
+    np.testing.assert_array_equal(a.oof_distances_, b.oof_distances_)
+    c, d = (RTWNearestCentroid(**common, random_state=make()).fit(X, y) for _ in range(2))
+    assert c._fit_record.seeds == d._fit_record.seeds

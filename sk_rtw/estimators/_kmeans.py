@@ -6,9 +6,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from sklearn.base import BaseEstimator, ClusterMixin, TransformerMixin
-from sklearn.utils import check_random_state
 from sklearn.utils.validation import check_is_fitted
 
+from .._random import check_random_state
 from .._settings import DEVICE_PARAMETER, PRESET_PARAMETER
 from ..methods import FitContext, get_method
 from ..utils import check_series_collection

@@ -25,8 +25,8 @@ from typing import Any
 
 import numpy as np
 from sklearn.model_selection import KFold, StratifiedKFold
-from sklearn.utils import check_random_state
 
+from .._random import check_random_state
 from ..dtw import dtw_pairwise_distance
 from ..utils import SeriesCollection, check_series_collection
 from ._record import CentroidFitRecord

@@ -13,8 +13,8 @@ import math
 from typing import Any
 
 import numpy as np
-from sklearn.utils import check_random_state
 
+from .._random import check_random_state
 from ..dtw import dtw_pairwise_distance
 from ..utils import SeriesCollection
 from ._selection import Selection, candidate_key, class_counts, class_medoids

@@ -44,8 +44,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from sklearn.utils import check_random_state
 
+from .._random import check_random_state
 from ..dtw import dtw_nearest_distance, dtw_pairwise_distance
 from ..utils import SeriesCollection
 from ._choice import AutoChoice, mcnemar
