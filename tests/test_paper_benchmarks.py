@@ -289,3 +289,21 @@ def test_manifold_classification_runs_one_fold(tmp_path):
         assert f"| quaternion | {row}" in text and f"| spd | {row}" in text
     coords = manifold_classification.coordinates(np.ones((2, 3, 2, 2)), "spd")
     assert coords.shape == (2, 3, 3)  # (n, channels, T): the three distinct entries
+
+
+def test_the_fingerprint_is_reproducible_and_compares(tmp_path, capsys, monkeypatch):
+    """Two runs of the manifold part give the same bytes; an array one rounding step
+    away is named."""
+    from benchmarks import fingerprint
+
+    first, second = tmp_path / "a.npz", tmp_path / "b.npz"
+    kept = {k: fingerprint.MANIFOLDS[k] for k in ("euc1", "quat", "spd2")}
+    monkeypatch.setattr(fingerprint, "MANIFOLDS", kept)
+    for path in (first, second):
+        assert fingerprint.main(["--out", str(path), "--quick", "--quiet"]) == 0
+    assert fingerprint.main(["--compare", str(first), str(second)]) == 0
+    arrays = dict(np.load(first))
+    arrays["pw/quat/None/False"] = np.nextafter(arrays["pw/quat/None/False"], np.inf)
+    np.savez(second, **arrays)
+    assert fingerprint.main(["--compare", str(first), str(second)]) == 1
+    assert "different: pw/quat/None/False" in capsys.readouterr().out
