@@ -6,10 +6,10 @@ Align, average and classify time series whose samples live on Riemannian manifol
 from . import baselines, datasets, methods, metrics, statistics
 
 # ``sk_rtw.align`` is the function (the paper's verb, ``sk_rtw.align(X, manifold=...)``):
-# the name shadows the engine's package of the same name as an attribute, so its records
-# are imported, ``from sk_rtw.align import PRESETS, KNOBS``, not reached as
-# ``sk_rtw.align.PRESETS``. Renaming either would break every user's first line; the
-# import form works for both, and help(sk_rtw.align) shows the function.
+# as an attribute the name shadows the engine's package, whose records are therefore
+# imported from it (``from sk_rtw.align import PRESETS, KNOBS``), not read off the
+# function. Renaming either would break every user's first line; the import form works
+# for both, and help(sk_rtw.align) shows the function.
 from .align import Alignment, align
 from .dtw import (
     dtw_cost_matrix,
