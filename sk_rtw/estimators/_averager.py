@@ -7,8 +7,6 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from sklearn.base import BaseEstimator, TransformerMixin
-from sklearn.utils import column_or_1d
-from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted
 
 from .._random import check_random_state
@@ -16,7 +14,7 @@ from .._settings import PRESETS
 from ..dtw import dtw_pairwise_distance
 from ..methods import FitContext, get_method
 from ..representations import represent, represented_manifold
-from ..utils import SeriesCollection, check_series_collection
+from ..utils import SeriesCollection, check_labels, check_series_collection, encode_labels
 from ..utils._params import declare_parameters, validate_parameters
 from ._choice import DEFAULT_CHOICE, AutoChoice, mcnemar
 from ._core import _label
@@ -225,8 +223,8 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         if y is None:
             labels = np.zeros(collection.n_series, dtype=int)
         else:
-            labels = _check_labels(y, collection.n_series, require_two_classes)
-        classes, codes = _encode(labels)
+            labels = check_labels(y, collection.n_series, require_two_classes)
+        classes, codes = encode_labels(labels)
         if require_two_classes and len(classes) < 2:
             raise ValueError(
                 f"{type(self).__name__} needs at least 2 classes in y; got {len(classes)} "
@@ -330,7 +328,7 @@ class RTWAverager(TransformerMixin, BaseEstimator):
         shortest = 2 if self.representation_ == "velocity" else 1
         collection = check_series_collection(X, self.manifold_, min_length=shortest)
         space = represented_manifold(self.manifold_, self.representation_)
-        means = check_series_collection(self.means_, space, name="means_")
+        means = check_series_collection(self.means_, space, name="means_", min_length=1)
         return represent(collection, self.representation_), means
 
     def _centroid_distances(self, X: Any) -> np.ndarray:
@@ -456,42 +454,3 @@ class NTWAverager(RTWAverager):
             device=device,
             verbose=verbose,
         )
-
-
-def _check_labels(y: Any, n_series: int, classification: bool) -> np.ndarray:
-    if isinstance(y, (list, tuple)) and len({isinstance(v, str) for v in y}) > 1:
-        y = np.array(y, dtype=object)  # keep mixed str/number labels as they are
-    labels = column_or_1d(y, warn=True)
-    if len(labels) != n_series:
-        raise ValueError(
-            f"X has {n_series} series but y has {len(labels)} labels: X holds one series per "
-            "row, (n_series, n_timepoints[, *point_shape]), or is a list of series; a "
-            "long-format table (one row per sample) must be pivoted first, e.g. "
-            "df.pivot(index='series', columns='time', values='value')"
-        )
-    if labels.dtype == object:
-        for i, value in enumerate(labels.tolist()):
-            if value is None or (isinstance(value, float) and np.isnan(value)):
-                raise ValueError(f"y[{i}] is {value!r}: labels must not be missing (None or NaN)")
-    if labels.dtype.kind == "f" and not np.isfinite(labels).all():  # before any cast
-        first = int(np.argmax(~np.isfinite(labels)))
-        raise ValueError(
-            f"y[{first}] is {labels[first]}: labels must not be missing (NaN) or infinite"
-        )
-    mixed = labels.dtype == object and len({type(v) for v in labels.tolist()}) > 1
-    if classification and not mixed:  # scikit-learn cannot sort mixed str/int labels
-        check_classification_targets(labels)
-    return labels
-
-
-def _encode(labels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Sorted classes and integer codes; mixed label types are sorted by type, then value."""
-    try:
-        classes, codes = np.unique(labels, return_inverse=True)
-        return classes, codes.ravel()
-    except TypeError:
-        ordered = sorted(set(labels.tolist()), key=lambda v: (type(v).__name__, v))
-        classes = np.empty(len(ordered), dtype=object)
-        classes[:] = ordered
-        lookup = {v: i for i, v in enumerate(ordered)}
-        return classes, np.array([lookup[v] for v in labels.tolist()])
