@@ -3,7 +3,7 @@
 Align, average and classify time series whose samples live on Riemannian manifolds.
 """
 
-from . import baselines, datasets, methods, metrics, statistics
+from . import baselines, datasets, forest, methods, metrics, statistics
 
 # ``sk_rtw.align`` is the function (the paper's verb, ``sk_rtw.align(X, manifold=...)``):
 # as an attribute the name shadows the engine's package, whose records are therefore
@@ -26,10 +26,10 @@ from .estimators import (
     RTWKMeans,
     RTWNearestCentroid,
     RTWPrototypeClassifier,
-    RTWProximityForest,
     TTWAverager,
     TTWNearestCentroid,
 )
+from .forest import ElasticSplitter, RTWProximityForest
 from .manifolds import (
     SPD,
     Euclidean,
@@ -57,6 +57,7 @@ __all__ = [
     "Alignment",
     "AutoChoice",
     "ConfidenceTube",
+    "ElasticSplitter",
     "Euclidean",
     "Manifold",
     "NTWAverager",
@@ -83,6 +84,7 @@ __all__ = [
     "dtw_nearest_distance",
     "dtw_pairwise_distance",
     "dtw_path",
+    "forest",
     "get_manifold",
     "methods",
     "metrics",

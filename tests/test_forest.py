@@ -16,13 +16,15 @@ from sklearn.utils.estimator_checks import parametrize_with_checks
 from sk_rtw import RTWProximityForest, tangent_velocity
 from sk_rtw.dtw import mean_diagonal_cost, nearest_group, prepare_series
 from sk_rtw.dtw._kernels import sakoe_chiba_rows
-from sk_rtw.estimators._proximity_split import (
+from sk_rtw.forest import (
+    ElasticSplitter,
     Measure,
     NodeSeries,
-    best_split,
+    TrainingSet,
     gini,
     gini_gain,
 )
+from sk_rtw.forest._tree import best_split
 from sk_rtw.manifolds import SPD, Product, Quaternion, Sphere
 from sk_rtw.representations import represent
 from sk_rtw.utils import check_series_collection
@@ -66,9 +68,11 @@ def test_the_same_seed_gives_the_same_forest_for_any_n_jobs():
     test, _ = three_classes(seed=5)
     np.testing.assert_array_equal(one.predict_proba(test), two.predict_proba(test))
     for a, b in zip(one.trees_, two.trees_, strict=True):
-        assert a.n_nodes_ == b.n_nodes_ and a.root_.measure == b.root_.measure
+        assert a.n_nodes_ == b.n_nodes_ and a.root_.split.measure == b.root_.split.measure
     other = RTWProximityForest(n_trees=12, random_state=4).fit(X, y)
-    assert [t.root_.measure for t in other.trees_] != [t.root_.measure for t in one.trees_]
+    assert [t.root_.split.measure for t in other.trees_] != [
+        t.root_.split.measure for t in one.trees_
+    ]
 
 
 def test_training_series_reach_their_own_pure_leaves():
@@ -79,8 +83,8 @@ def test_training_series_reach_their_own_pure_leaves():
     forest = RTWProximityForest(n_trees=5, random_state=0).fit(X, y)
     codes = np.searchsorted(forest.classes_, y)
     for tree in forest.trees_:
-        proba = tree.predict_proba(forest._prepared(X), forest._train)
-        np.testing.assert_array_equal(proba, np.eye(3)[codes])
+        np.testing.assert_array_equal(tree.predict_proba(X), np.eye(3)[codes])
+        np.testing.assert_array_equal(tree.predict(X), y)
     assert forest.score(X, y) == 1.0
 
 
@@ -88,8 +92,7 @@ def test_predict_proba_is_the_mean_of_the_trees_leaves():
     X, y = three_classes()
     test, test_y = three_classes(seed=9)
     forest = RTWProximityForest(n_trees=7, random_state=1).fit(X, y)
-    data = forest._prepared(test)
-    votes = np.mean([tree.predict_proba(data, forest._train) for tree in forest.trees_], 0)
+    votes = np.mean([tree.predict_proba(test) for tree in forest.trees_], 0)
     np.testing.assert_allclose(forest.predict_proba(test), votes, atol=1e-15)
     np.testing.assert_allclose(forest.predict_proba(test).sum(1), 1.0)
     assert np.array_equal(forest.predict(test), forest.classes_[votes.argmax(1)])
@@ -124,26 +127,27 @@ def test_every_candidate_sends_each_series_to_its_nearest_exemplar(manifold):
     distances (manifold DTW of the drawn representation), for every representation."""
     X = np.stack([random_walk(manifold, 12, s, step=0.3) for s in range(14)])
     codes = np.repeat([0, 1], 7)
-    collection = check_series_collection(X, manifold)
-    collections = {r: represent(collection, r) for r in ("raw", "velocity")}
-    data = {r: prepare_series(c) for r, c in collections.items()}
+    training = TrainingSet.build(check_series_collection(X, manifold), ("raw", "velocity"),
+                                 codes, 2)  # fmt: skip
+    splitters = (ElasticSplitter().resolved(
+        {"n_candidates": 3, "representation": "both", "exemplars": "series"}),)  # fmt: skip
     indices = np.arange(2, 14)
     for seed in range(6):
-        node = NodeSeries(indices, codes[indices])
-        split, branches = best_split(
-            np.random.default_rng(seed), node, data, collections, 2, 3, ("raw", "velocity"),
-            "series",
-        )  # fmt: skip
+        node = NodeSeries(training, indices, codes[indices])
+        split, gain, branches = best_split(node, splitters, np.random.default_rng(seed))
         measure = split.measure
-        space = collections[measure.representation]
+        space = training.collections[measure.representation]
         expected = _brute_force_branches(
             [space.series(i) for i in indices],
-            [space.series(i) for i in split.exemplars],
+            [space.series(i) for i in split.sources],
             measure, space.manifold,
         )  # fmt: skip
         np.testing.assert_array_equal(branches, expected)
-        assert split.gain == pytest.approx(gini_gain(codes[indices], branches, 2, 2))
-        assert set(codes[split.exemplars]) == {0, 1}  # one exemplar of each class
+        assert gain == pytest.approx(gini_gain(codes[indices], branches, 2, 2))
+        assert set(codes[split.sources]) == {0, 1}  # one exemplar of each class
+        # the split routes any series by the exemplars it holds: the same branches
+        rest = {r: training.prepared[r].take(indices) for r in ("raw", "velocity")}
+        np.testing.assert_array_equal(split.route(rest), branches)
 
 
 def test_gini_and_its_gain_by_hand():
@@ -209,27 +213,29 @@ def test_multivariate_euclidean_series_and_the_velocity_alone():
     forest = RTWProximityForest(n_trees=5, representation="velocity", random_state=0)
     forest.fit(X3, y)
     assert forest.representations_ == ("velocity",)
-    assert {t.root_.measure.representation for t in forest.trees_} == {"velocity"}
+    assert {t.root_.split.measure.representation for t in forest.trees_} == {"velocity"}
     raw = RTWProximityForest(n_trees=5, representation="raw", random_state=0).fit(X3, y)
-    assert {t.root_.measure.representation for t in raw.trees_} == {"raw"}
+    assert {t.root_.split.measure.representation for t in raw.trees_} == {"raw"}
 
 
-def test_a_tree_reads_its_exemplars_from_the_training_set():
+def test_a_split_holds_its_exemplar_series_not_the_training_set():
     X, y = three_classes()
-    forest = RTWProximityForest(n_trees=3, random_state=2).fit(X, y)
+    forest = RTWProximityForest(n_trees=3, representation="raw", random_state=2).fit(X, y)
     root = forest.trees_[0].root_
     classes = forest.classes_[root.split.classes]
-    assert list(y[root.split.exemplars]) == list(classes)
+    assert list(y[root.split.sources]) == list(classes)
+    np.testing.assert_array_equal(root.split.exemplars.data[..., 0], X[root.split.sources])
     assert len(root.children) == len(classes) == 3
-    assert str(root.measure).startswith(("DTW", "ADTW"))
+    assert str(root.split.measure).startswith(("DTW", "ADTW"))
+    assert not [name for name in vars(forest) if "train" in name]
 
 
 def test_mean_exemplars_are_averages_with_randomness_of_their_own():
     X, y = three_classes(n_per_class=9)
     forest = RTWProximityForest(n_trees=4, exemplars="mean", random_state=0).fit(X, y)
     root = forest.trees_[0].root_
-    assert (root.split.exemplars == -1).all()  # 9 series per class: subsets of 3 averaged
-    assert root.split.means.n_series == 3
+    assert (root.split.sources == -1).all()  # 9 series per class: subsets of 3 averaged
+    assert root.split.exemplars.n_series == 3
     again = RTWProximityForest(n_trees=4, exemplars="mean", random_state=0).fit(X, y)
     np.testing.assert_array_equal(forest.predict_proba(X), again.predict_proba(X))
     assert forest.score(X, y) == 1.0

@@ -29,14 +29,14 @@ print(f"test accuracy {forest.score(X_test, y_test):.3f} with {len(forest.trees_
 
 # %%
 # Each root split names its measure and, for every class, the training series it drew
-# as the exemplar (``split.exemplars`` are indices into the training set). A velocity
+# as the exemplar (``split.sources`` says which; the split holds the series). A velocity
 # measure compares the first differences, so its exemplars are drawn as such.
 velocity = tangent_velocity(X_train)
 fig, axes = plt.subplots(1, 3, figsize=(15, 3.8), sharex=True)
 for ax, tree in zip(axes, forest.trees_[:3], strict=True):
     split = tree.root_.split
     shown = velocity if split.measure.representation == "velocity" else X_train
-    for code, index in zip(split.classes, split.exemplars, strict=True):
+    for code, index in zip(split.classes, split.sources, strict=True):
         label = forest.classes_[code]
         ax.plot(shown[index], lw=1.6, label=f"class {label} (series {index})")
     ax.set_title(str(split.measure).replace(", point", ",\npoint"), fontsize=9)

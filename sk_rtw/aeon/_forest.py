@@ -7,11 +7,12 @@ from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
-from ..estimators import RTWProximityForest
+from ..forest import RTWProximityForest
 from ..utils._params import declare_parameters
 from ._base import DelegatingClassifier
 
 if TYPE_CHECKING:
+    from ..forest import Splitter
     from ..manifolds import Manifold
 
 _FOREST = RTWProximityForest._declaration  # type: ignore[attr-defined]
@@ -73,6 +74,7 @@ class RTWProximityForestClassifier(DelegatingClassifier):
         manifold: str | Manifold = "euclidean",
         *,
         n_trees: int = 100,
+        splitters: tuple[Splitter, ...] | None = None,
         n_candidates: int = 5,
         representation: str = "both",
         exemplars: str = "series",
@@ -83,6 +85,7 @@ class RTWProximityForestClassifier(DelegatingClassifier):
     ) -> None:
         self.manifold = manifold
         self.n_trees = n_trees
+        self.splitters = splitters
         self.n_candidates = n_candidates
         self.representation = representation
         self.exemplars = exemplars

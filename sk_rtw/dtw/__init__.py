@@ -30,11 +30,12 @@ from ._costs import optimal_path, point_cost_matrix
 from ._dtw import check_window, dtw_cost_matrix, dtw_distance, dtw_pairwise_distance, dtw_path
 from ._medoid import medoid_index
 from ._paths import has_compiled_costs, mean_matched_positions, path_indices
-from ._prepared import PreparedSeries, mean_diagonal_cost, nearest_group, prepare_series
+from ._prepared import EXPONENTS, PreparedSeries, mean_diagonal_cost, nearest_group, prepare_series
 from ._search import dtw_nearest_distance
 from ._soft import soft_dtw_batch
 
 __all__ = [
+    "EXPONENTS",
     "PreparedSeries",
     "check_window",
     "coarse_collection",

@@ -1,10 +1,9 @@
 """scikit-learn estimators: class means by time warping, nearest-centroid and prototype
-classifiers, and a proximity forest."""
+classifiers (the proximity forest is :mod:`sk_rtw.forest`)."""
 
 from ._averager import NTWAverager, RTWAverager, TTWAverager
 from ._choice import AutoChoice
 from ._classifier import NTWNearestCentroid, RTWNearestCentroid, TTWNearestCentroid
-from ._forest import RTWProximityForest
 from ._kmeans import RTWKMeans
 from ._prototypes import RTWPrototypeClassifier
 from ._ridge_readout import RidgeGCVClassifier
@@ -17,7 +16,6 @@ __all__ = [
     "RTWKMeans",
     "RTWNearestCentroid",
     "RTWPrototypeClassifier",
-    "RTWProximityForest",
     "RidgeGCVClassifier",
     "TTWAverager",
     "TTWNearestCentroid",

@@ -84,7 +84,8 @@ def out_of_fold_distances(
             fits = record.refit(collection, rows, kept, verbose=max(0, verbose - 1), owner=owner)
             for m, fit in zip(kept, fits, strict=True):
                 fold_means[m] = fit.mean
-        reference = check_series_collection(fold_means, collection.manifold, name="means_")
+        reference = check_series_collection(fold_means, collection.manifold, name="means_",
+                                            min_length=1)  # fmt: skip
         distances[test] = dtw_pairwise_distance(
             collection.subset(test), reference, window=record.dtw_window,
             n_jobs=record.context.n_jobs,

@@ -1,0 +1,273 @@
+"""RTWProximityForest: Proximity Forest on any manifold, with the tangent velocity."""
+
+from __future__ import annotations
+
+import sys
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from sklearn.base import BaseEstimator, ClassifierMixin
+from sklearn.utils.validation import check_is_fitted
+
+from .._random import check_generator
+from .._threads import limited_threads, resolve_n_jobs, thread_map
+from ..utils import check_classes, check_series_collection
+from ..utils._common_params import MANIFOLD, N_JOBS, RANDOM_STATE, VERBOSE
+from ..utils._constraints import Interval
+from ..utils._params import Parameter, declare_parameters, validate_parameters
+from ._params import (
+    EXEMPLARS,
+    MAX_DEPTH,
+    N_CANDIDATES,
+    REPRESENTATION,
+    SPLITTERS,
+    representations_read,
+    resolve_splitters,
+)
+from ._series import TrainingSet, unit_frame
+from ._splitter import Splitter
+from ._tree import ProximityTree, prepare_representations
+
+if TYPE_CHECKING:
+    from ..manifolds import Manifold
+
+N_TREES = Parameter(
+    "n_trees",
+    (Interval(int, 1),),
+    "Trees of the forest; fit and prediction time grow in proportion (Proximity Forest's "
+    "100 is where its accuracy levels off).",
+)
+
+FOREST_PARAMETERS = (
+    MANIFOLD, N_TREES, SPLITTERS, N_CANDIDATES, REPRESENTATION, EXEMPLARS, MAX_DEPTH, N_JOBS,
+    RANDOM_STATE, VERBOSE,
+)  # fmt: skip
+FOREST_DEFAULTS = {
+    "manifold": "euclidean",
+    "n_trees": 100,
+    "splitters": None,
+    "n_candidates": 5,
+    "representation": "both",
+    "exemplars": "series",
+    "max_depth": None,
+    "n_jobs": None,
+    "random_state": None,
+    "verbose": 0,
+}
+
+
+@declare_parameters(FOREST_PARAMETERS, FOREST_DEFAULTS)
+class RTWProximityForest(ClassifierMixin, BaseEstimator):
+    """Proximity Forest on any manifold: trees that split by the nearest exemplar under
+    a randomly drawn manifold-DTW measure, on the series or their tangent velocity.
+
+    Each tree splits a node by drawing ``n_candidates`` candidate splits and keeping the
+    one with the largest Gini gain; a candidate draws one training series per class of
+    the node as exemplars and a measure of the manifold-DTW family, and sends every
+    series of the node to the branch of its nearest exemplar. The measure draws, as
+    Proximity Forest 2.0 (Herrmann et al. 2023) draws its DTW family: the representation
+    (the series, or their tangent velocity: the manifold's derivative series,
+    :func:`sk_rtw.tangent_velocity`), the point cost (the geodesic distance to the power
+    1/2, 1 or 2), and either DTW in a Sakoe-Chiba band of radius up to a quarter of the
+    length, or amerced DTW without a band (a penalty on every step off the diagonal,
+    drawn on a scale taken from the node's series). The draw's recipe (exponents, bands,
+    penalties) is a parameter object, :class:`~sk_rtw.forest.ElasticSplitter`, and
+    ``splitters=`` takes any kinds of split that follow its protocol. Trees split until
+    their leaves are pure; ``predict_proba`` averages the class proportions of the
+    leaves the series reach in every tree (with pure leaves: the trees' vote). The
+    nearest exemplar is found by the package's nearest search (lower bounds, early
+    abandoning, the exhaustive answer).
+
+    When to pick it: it is the most accurate classifier of the package where classes
+    differ in shape details (UCR page of the documentation: ahead of
+    :class:`RTWNearestCentroid` on most datasets), and the tangent velocity makes it
+    strong on manifold-valued demonstrations (R-LASA page). It costs more: a forest's fit
+    computes about ``n_trees x n_candidates x depth x n_classes`` DTW distances per
+    training series and prediction ``n_trees x depth x n_classes`` per series, where a
+    nearest-centroid classifier computes one per centroid; it gives no class means to
+    plot or to feed movement models (its exemplars are training series). Fit and
+    prediction time grow with ``n_trees``; ``n_jobs`` builds and queries the trees on
+    several threads with the same result. The fitted forest keeps what routing needs
+    (every split's exemplar series), not the training set.
+
+    Measured (UCR page, one thread, 100 trees): on UCR datasets of 16-180 training
+    series, 0.90-0.93 mean accuracy where :class:`RTWNearestCentroid` reads 0.85-0.86
+    (Proximity Forest 1.0's published 0.90, MiniRocket's 0.92-0.93); fit 0.4 s to
+    3 minutes per dataset, 1.5-2x Proximity Forest 2.0's published single-CPU time;
+    prediction about 3x aeon's 1-NN DTW (median per dataset). A training set of 8,926
+    short series takes half an hour to fit.
+
+    Parameters
+    ----------
+    %(parameters)s
+
+    Attributes
+    ----------
+    classes_ : ndarray of shape (n_classes,)
+    manifold_ : Manifold
+        The manifold resolved against the training data.
+    trees_ : list of ProximityTree
+        The fitted trees (:class:`~sk_rtw.forest.ProximityTree`, each a classifier of its
+        own); ``trees_[k].root_`` is a tree's root (:class:`~sk_rtw.forest.ProximityNode`:
+        its ``split`` holds what routes a series, for the elastic splitter the measure
+        and each branch's exemplar series).
+    splitters_ : tuple of Splitter
+        The splitters resolved (the forest's values in place of their None).
+    representations_ : tuple of str
+        The representations the splitters read.
+    scale_ : float
+        What the series are divided by before any distance (a power of two for
+        magnitudes beyond 1e+-100 on R^d and SPD(k), else 1): the forest is the same at
+        any magnitude.
+    n_features_in_ : int
+        Time points of the training series, for equal-length univariate data only.
+
+    See Also
+    --------
+    sk_rtw.forest.ElasticSplitter : the recipe of the elastic split.
+    RTWNearestCentroid : fewer, readable centroids; faster, less accurate.
+    sk_rtw.tangent_velocity : the velocity representation.
+
+    References
+    ----------
+    Lucas et al., "Proximity Forest: an effective and scalable distance-based classifier
+    for time series", Data Mining and Knowledge Discovery 33 (2019). Herrmann, Tan,
+    Salehi and Webb, "Proximity Forest 2.0: a new effective and scalable
+    similarity-based classifier for time series", arXiv:2304.05800 (2023).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sk_rtw import RTWProximityForest
+    >>> t = np.linspace(0, 1, 40)
+    >>> X = np.stack([np.sin(2 * np.pi * t ** p) for p in (0.8, 1.0, 1.2)]
+    ...              + [np.cos(2 * np.pi * t ** p) for p in (0.8, 1.0, 1.2)])
+    >>> y = ["sin"] * 3 + ["cos"] * 3
+    >>> forest = RTWProximityForest(n_trees=10, random_state=0).fit(X, y)
+    >>> forest.predict(X[[0, 5]]).tolist()
+    ['sin', 'cos']
+    """
+
+    def __init__(
+        self,
+        manifold: str | Manifold = "euclidean",
+        *,
+        n_trees: int = 100,
+        splitters: tuple[Splitter, ...] | None = None,
+        n_candidates: int = 5,
+        representation: str = "both",
+        exemplars: str = "series",
+        max_depth: int | None = None,
+        n_jobs: int | None = None,
+        random_state: int | np.random.RandomState | np.random.Generator | None = None,
+        verbose: bool | int = 0,
+    ) -> None:
+        self.manifold = manifold
+        self.n_trees = n_trees
+        self.splitters = splitters
+        self.n_candidates = n_candidates
+        self.representation = representation
+        self.exemplars = exemplars
+        self.max_depth = max_depth
+        self.n_jobs = n_jobs
+        self.random_state = random_state
+        self.verbose = verbose
+
+    def fit(self, X: Any, y: Any) -> RTWProximityForest:
+        """Grow the trees.
+
+        Parameters
+        ----------
+        X : array-like of shape (n_series, n_timepoints[, *point_shape]) or list
+            Training series (a list of ``(T_i, *point_shape)`` arrays for unequal
+            lengths); at least 2 time points each where the velocity is drawn.
+        y : array-like of shape (n_series,)
+            Labels of at least two classes.
+
+        Returns
+        -------
+        self
+        """
+        params = validate_parameters(self)
+        splitters = resolve_splitters(params)
+        representations = representations_read(splitters)
+        shortest = 2 if "velocity" in representations else 1
+        collection = check_series_collection(X, self.manifold, min_length=shortest)
+        classes, codes = check_classes(type(self).__name__, y, collection.n_series)
+        rng = check_generator(self.random_state)
+        seeds = rng.integers(np.iinfo(np.int64).max, size=params["n_trees"])  # before any work
+        unit, scale = unit_frame(collection)
+        training = TrainingSet.build(unit, representations, codes, len(classes))
+        tree_params = {name: params[name] for name in ProximityTree._declaration.names
+                       if name not in ("manifold", "random_state")}  # fmt: skip
+        trees = [ProximityTree(self.manifold, **tree_params, random_state=int(seed))
+                 for seed in seeds]  # fmt: skip
+        verbose, total, manifold = int(params["verbose"]), len(trees), collection.manifold
+
+        def grow(position: int) -> ProximityTree:
+            tree = trees[position]._grow(
+                training, splitters, classes, manifold, np.random.default_rng(seeds[position]),
+                scale,
+            )
+            if verbose:
+                print(
+                    f"{type(self).__name__}: tree {position + 1}/{total}: {tree.n_nodes_} "
+                    f"nodes, depth {tree.depth_}, {tree.seconds_:.2f} s",
+                    file=sys.stderr, flush=True,
+                )  # fmt: skip
+            return tree
+
+        with limited_threads(1):  # one thread per tree, each tree on one core
+            self.trees_ = thread_map(grow, range(total), resolve_n_jobs(params["n_jobs"]))
+        self.classes_ = classes
+        self.manifold_ = manifold
+        self.splitters_ = splitters
+        self.representations_ = representations
+        self.scale_ = scale
+        if collection.equal_length and collection.manifold.point_shape == (1,):
+            self.n_features_in_ = collection.max_length
+        return self
+
+    def predict_proba(self, X: Any) -> np.ndarray:
+        """The mean over the trees of the class proportions of the leaf each series
+        reaches (with pure leaves, the fraction of trees voting for each class).
+
+        Parameters
+        ----------
+        X : array-like of shape (n_series, n_timepoints[, *point_shape]) or list
+            Series on the training manifold; any length.
+
+        Returns
+        -------
+        proba : ndarray of shape (n_series, n_classes)
+        """
+        check_is_fitted(self, "trees_")
+        data = prepare_representations(X, self.manifold_, self.representations_, self.scale_)
+        n = next(iter(data.values())).n_series
+        with limited_threads(1):
+            votes = thread_map(lambda tree: tree._proba(data, n), self.trees_,
+                               resolve_n_jobs(self.n_jobs))  # fmt: skip
+        total = np.zeros((n, len(self.classes_)))
+        for vote in votes:  # in the trees' order: the same sum for any n_jobs
+            total += vote
+        return total / len(votes)
+
+    def predict(self, X: Any) -> np.ndarray:
+        """The class with the largest :meth:`predict_proba` (ties to the first class).
+
+        Parameters
+        ----------
+        X : array-like of shape (n_series, n_timepoints[, *point_shape]) or list
+
+        Returns
+        -------
+        labels : ndarray of shape (n_series,)
+        """
+        proba = self.predict_proba(X)
+        return self.classes_[np.argmax(proba, axis=1)]
+
+    def __sklearn_tags__(self):
+        tags = super().__sklearn_tags__()
+        tags.input_tags.allow_nan = False
+        tags.non_deterministic = False
+        return tags

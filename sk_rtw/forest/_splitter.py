@@ -1,0 +1,66 @@
+"""The one protocol of every kind of split: a splitter draws candidates, a candidate
+routes series.
+
+A :class:`Splitter` is a recipe, a parameter object with defaults (scikit-learn's
+``get_params`` and ``clone`` apply; a grid passes several of them): at a node it draws a
+candidate :class:`Split` from the node's series (:class:`~._series.NodeSeries`) and the
+tree's generator. A split holds what it needs to route (exemplar series prepared, a
+shapelet and its threshold), never indices into the training set, and routes series the
+same way when the tree grows and when it predicts (:meth:`Split.route`). The tree scores
+the candidates by Gini gain and keeps the best; it never asks which kind a split is, so
+a new kind is one splitter class and one split class.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from collections.abc import Mapping
+from typing import Any, Protocol, runtime_checkable
+
+import numpy as np
+from sklearn.base import BaseEstimator
+
+from ..dtw import PreparedSeries
+from ._series import NodeSeries
+
+
+@runtime_checkable
+class Split(Protocol):
+    """A candidate split of a node: ``n_branches`` branches and the rule that sends a
+    series to one of them."""
+
+    @property
+    def n_branches(self) -> int: ...
+
+    def route(self, series: Mapping[str, PreparedSeries]) -> np.ndarray:
+        """The branch (``0..n_branches - 1``) of every series; ``series`` maps a
+        representation to the series in it (read only for the representations the split
+        compares)."""
+        ...
+
+
+class Splitter(BaseEstimator, ABC):
+    """A kind of split and its recipe (the base of :class:`ElasticSplitter` and of the
+    kinds to come).
+
+    A subclass declares its parameters, may leave ``n_candidates`` and
+    ``representation`` as None (then the forest's values apply, :meth:`resolved`), and
+    implements :meth:`draw`.
+    """
+
+    n_candidates: int | None
+    representation: str | None
+
+    @abstractmethod
+    def resolved(self, defaults: Mapping[str, Any]) -> Splitter:
+        """A checked copy in which every None that means "the forest's value" is
+        replaced by ``defaults[name]``."""
+
+    @property
+    @abstractmethod
+    def representations(self) -> tuple[str, ...]:
+        """The representations its candidates read (of a resolved splitter)."""
+
+    @abstractmethod
+    def draw(self, node: NodeSeries, rng: np.random.Generator) -> Split:
+        """One candidate split of ``node`` (of a resolved splitter)."""

@@ -1,0 +1,193 @@
+"""The forest's splitter seam: one protocol for every kind of split, the elastic recipe
+as a parameter object, a tree usable alone, and a new kind of split as one class."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pytest
+from sklearn.base import clone
+from sklearn.model_selection import GridSearchCV
+from sklearn.utils.estimator_checks import parametrize_with_checks
+
+from sk_rtw import ElasticSplitter, RTWProximityForest
+from sk_rtw.forest import ProximityTree, Split, Splitter
+
+from .test_estimators import EXPECTED_FAILURES
+from .test_forest import three_classes
+
+
+def _expected_failures(estimator):
+    return EXPECTED_FAILURES
+
+
+@parametrize_with_checks(
+    [ProximityTree(random_state=0)], expected_failed_checks=_expected_failures
+)
+def test_a_tree_alone_is_a_scikit_learn_classifier(estimator, check):
+    check(estimator)
+
+
+def _measures(forest):
+    out = []
+    for tree in forest.trees_:
+        stack = [tree.root_]
+        while stack:
+            node = stack.pop()
+            if node.split is not None:
+                out.append(node.split.measure)
+                stack.extend(node.children)
+    return out
+
+
+def test_the_default_splitter_written_out_is_the_default_forest():
+    X, y = three_classes()
+    test, _ = three_classes(seed=4)
+    default = RTWProximityForest(n_trees=6, random_state=0).fit(X, y)
+    written = ElasticSplitter(
+        n_candidates=5, representation="both", exemplars="series", exponents=(0.5, 1.0, 2.0),
+        measures=("dtw", "adtw"), max_window=0.25, penalty_steps=100, penalty_exponent=5,
+        penalty_pairs=50, mean_subset=10, mean_iterations=5,
+    )  # fmt: skip
+    explicit = RTWProximityForest(n_trees=6, splitters=[written], random_state=0).fit(X, y)
+    np.testing.assert_array_equal(default.predict_proba(test), explicit.predict_proba(test))
+    assert _measures(default) == _measures(explicit)
+    assert default.splitters_[0].get_params() == written.get_params()
+
+
+def test_the_recipe_decides_the_measures_drawn():
+    X, y = three_classes()
+    squared = RTWProximityForest(
+        n_trees=4, splitters=[ElasticSplitter(exponents=(2.0,), measures=("dtw",),
+                                              max_window=0.1)], random_state=0,
+    ).fit(X, y)  # fmt: skip
+    measures = _measures(squared)
+    assert {m.exponent for m in measures} == {2.0}
+    assert {m.warp_penalty for m in measures} == {0.0}
+    assert all(0.0 <= m.window <= 0.1 for m in measures)
+    amerced = RTWProximityForest(
+        n_trees=4, splitters=[ElasticSplitter(measures=("adtw",), penalty_steps=1)],
+        random_state=0,
+    ).fit(X, y)  # fmt: skip
+    assert {(m.window, m.warp_penalty) for m in _measures(amerced)} == {(None, 0.0)}
+
+
+def test_a_splitter_takes_the_forests_values_where_it_sets_none():
+    X, y = three_classes()
+    forest = RTWProximityForest(n_trees=3, representation="velocity", n_candidates=2,
+                                random_state=0).fit(X, y)  # fmt: skip
+    (resolved,) = forest.splitters_
+    assert (resolved.representation, resolved.n_candidates) == ("velocity", 2)
+    raw = [ElasticSplitter(representation="raw")]
+    own = RTWProximityForest(n_trees=3, representation="velocity", random_state=0,
+                             splitters=raw).fit(X, y)  # fmt: skip
+    assert own.representations_ == ("raw",)
+    assert {m.representation for m in _measures(own)} == {"raw"}
+
+
+@dataclass(frozen=True, eq=False)
+class _LevelSplit:
+    """Series whose mean value is below a threshold go left."""
+
+    threshold: float
+
+    @property
+    def n_branches(self) -> int:
+        return 2
+
+    def route(self, series):
+        raw = series["raw"]
+        means = np.array([raw.data[i, : raw.lengths[i]].mean() for i in range(raw.n_series)])
+        return (means >= self.threshold).astype(np.int64)
+
+
+class _LevelSplitter(Splitter):
+    """A kind of split written outside the package: a threshold on the series' mean,
+    drawn between two of the node's series (counts its draws)."""
+
+    def __init__(self, n_candidates=None, representation=None):
+        self.n_candidates = n_candidates
+        self.representation = representation
+
+    def resolved(self, defaults):
+        return _LevelSplitter(self.n_candidates or defaults["n_candidates"], "raw")
+
+    @property
+    def representations(self):
+        return ("raw",)
+
+    def draw(self, node, rng):
+        raw = node.series["raw"]
+        a, b = rng.choice(raw.n_series, size=2, replace=False)
+        means = [raw.data[i, : raw.lengths[i]].mean() for i in (a, b)]
+        _LevelSplitter.draws += 1
+        return _LevelSplit(float(np.mean(means)))
+
+    draws = 0
+
+
+def test_a_new_kind_of_split_is_one_class_and_mixes_with_the_elastic_one():
+    rng = np.random.default_rng(0)
+    X = rng.standard_normal((30, 20)) + np.repeat([0.0, 3.0], 15)[:, None]
+    y = np.repeat([0, 1], 15)
+    _LevelSplitter.draws = 0
+    level = RTWProximityForest(n_trees=3, splitters=[_LevelSplitter(n_candidates=4)],
+                               random_state=0).fit(X, y)  # fmt: skip
+    assert isinstance(level.trees_[0].root_.split, _LevelSplit)
+    assert isinstance(level.trees_[0].root_.split, Split)
+    assert _LevelSplitter.draws == 4 * sum(t.n_nodes_ - t.n_leaves_ for t in level.trees_)
+    assert level.score(X, y) == 1.0
+    mixed = RTWProximityForest(
+        n_trees=4, splitters=[ElasticSplitter(n_candidates=1), _LevelSplitter(n_candidates=1)],
+        random_state=0,
+    ).fit(X, y)  # fmt: skip
+    kinds = {type(t.root_.split).__name__ for t in mixed.trees_}
+    assert kinds <= {"NearestExemplarSplit", "_LevelSplit"} and kinds
+    assert mixed.score(X, y) == 1.0
+
+
+@pytest.mark.parametrize(
+    ("splitters", "match"),
+    [
+        ("elastic", "splitters"),
+        ([], "splitters"),
+        ([ElasticSplitter, ElasticSplitter()], "splitters"),
+        ([ElasticSplitter(exponents=(3.0,))], r"exponents.*ElasticSplitter"),
+        ([ElasticSplitter(measures=("lcss",))], "measures"),
+        ([ElasticSplitter(max_window=1.5)], "max_window"),
+        ([ElasticSplitter(penalty_steps=0)], "penalty_steps"),
+        ([ElasticSplitter(exemplars="medoid")], "exemplars"),
+        ([ElasticSplitter(n_candidates=0)], "n_candidates"),
+    ],
+)
+def test_bad_splitters_are_named(splitters, match):
+    X, y = three_classes(n_per_class=3)
+    with pytest.raises((ValueError, TypeError), match=match):
+        RTWProximityForest(n_trees=1, splitters=splitters).fit(X, y)
+
+
+def test_splitters_in_a_grid_search_and_through_clone():
+    X, y = three_classes(n_per_class=6)
+    grid = GridSearchCV(
+        RTWProximityForest(n_trees=3, random_state=0),
+        {"splitters": [None, (ElasticSplitter(exponents=(1.0,)),)]}, cv=2,
+    ).fit(X, y)  # fmt: skip
+    assert grid.best_score_ > 0.5
+    forest = RTWProximityForest(splitters=(ElasticSplitter(max_window=0.1),))
+    copy = clone(forest)
+    assert copy.splitters[0] is not forest.splitters[0]
+    assert copy.splitters[0].max_window == 0.1
+
+
+def test_a_tree_alone_and_in_a_forest_grow_from_the_same_seed_the_same_way():
+    X, y = three_classes()
+    tree = ProximityTree(random_state=7).fit(X, y)
+    again = ProximityTree(random_state=7).fit(X, y)
+    assert tree.n_nodes_ == again.n_nodes_
+    np.testing.assert_array_equal(tree.predict_proba(X), again.predict_proba(X))
+    assert tree.score(X, y) == 1.0
+    forest = RTWProximityForest(n_trees=2, random_state=0).fit(X, y)
+    member = forest.trees_[0]
+    assert member.classes_ is forest.classes_ and member.manifold_ == forest.manifold_
+    np.testing.assert_array_equal(member.predict(X), y)
