@@ -35,6 +35,17 @@ def velocity_collection(collection: SeriesCollection) -> SeriesCollection:
     steps = np.asarray(manifold.velocity(data[:, :-1], data[:, 1:]))
     steps = steps.reshape(collection.n_series, collection.max_length - 1, -1)
     lengths = collection.lengths - 1
+    valid = np.arange(steps.shape[1])[None, :] < lengths[:, None]
+    finite = np.isfinite(steps).all(-1)
+    if not finite[valid].all():
+        series, time = np.argwhere(valid & ~finite)[0]
+        note = manifold.spread_note(data[series, time : time + 2])
+        raise ValueError(
+            f"the tangent velocity of series {series} between time points {time} and "
+            f"{time + 1} is not finite on {manifold!r}"
+            + (f" ({note})" if note else "")
+            + ": the step between these points is beyond float64; rescale the series"
+        )
     for i in np.flatnonzero(lengths < steps.shape[1]):
         steps[i, lengths[i] :] = steps[i, lengths[i] - 1]
     return SeriesCollection(

@@ -617,4 +617,5 @@ def power_of_two_scale(magnitude: float) -> float | None:
     exponent = np.log10(magnitude)
     if -EXTREME_EXPONENT <= exponent <= EXTREME_EXPONENT:
         return None
-    return float(2.0 ** np.round(np.log2(magnitude)))
+    # within float64's powers of two (2^1024 overflows to inf, 2^-1075 underflows to 0)
+    return float(np.ldexp(1.0, int(np.clip(np.round(np.log2(magnitude)), -1022, 1023))))

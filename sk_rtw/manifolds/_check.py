@@ -16,6 +16,7 @@ import numpy as np
 import torch
 
 from ._base import Manifold
+from ._point_kernels import kernel_points, robust_distance, segment_codes
 
 
 class ManifoldCheckError(AssertionError):
@@ -47,11 +48,12 @@ def check_manifold(
     ``exp`` and ``exp`` inverts ``log`` within half the injectivity radius; ``exp``
     lands on the manifold; the distance is symmetric, non-negative, zero on the
     diagonal, satisfies the triangle inequality and equals the norm of the log;
-    ``pairwise_dist`` equals ``dist``; numpy and torch give the same numbers; the mean of
-    identical points is that point and the mean of two is the geodesic midpoint; the
-    gradients of ``exp``, ``log`` and the squared distance are finite at zero tangent
-    vectors and at coincident points; tangent coordinates (where defined) round-trip and
-    preserve the norm.
+    ``pairwise_dist`` equals ``dist``; the compiled DTW distance (from
+    ``distance_segments``, where the manifold declares them) equals ``dist``; numpy and
+    torch give the same numbers; the mean of identical points is that point and the mean
+    of two is the geodesic midpoint; the gradients of ``exp``, ``log`` and the squared
+    distance are finite at zero tangent vectors and at coincident points; tangent
+    coordinates (where defined) round-trip and preserve the norm.
 
     Parameters
     ----------
@@ -165,6 +167,19 @@ def check_manifold(
         _close(M, "pairwise_dist = dist", M.pairwise_dist(p, q), expected, atol)
 
     check("pairwise_dist = dist", pairwise)
+
+    def compiled_distance():
+        segments = segment_codes(M)  # raises for segments that do not tile a point
+        if segments is None:
+            return
+        flat_p = p.reshape(len(p), -1)
+        flat_q = q.reshape(len(q), -1)
+        kp, kq = kernel_points(M, flat_p), kernel_points(M, flat_q)
+        got = np.array([robust_distance(kp[i], kq[i], segments) for i in range(len(p))])
+        _close(M, "the compiled distance (distance_segments) = dist", got,
+               np.asarray(M.dist(p, q)), atol)  # fmt: skip
+
+    check("the compiled distance (distance_segments) = dist", compiled_distance)
 
     def numpy_and_torch():
         tp, tq = torch.as_tensor(p), torch.as_tensor(q)

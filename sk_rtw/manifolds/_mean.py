@@ -145,6 +145,21 @@ def frechet_mean(
     if codes is None:
         codes = torch.zeros(points.shape[0], dtype=torch.long, device=points.device)
     sizes = torch.bincount(codes) if sizes is None else sizes
+    try:
+        return _frechet_mean(manifold, points, codes, sizes, weights, start, max_iter, tol,
+                             differentiate, warn)  # fmt: skip
+    except torch.linalg.LinAlgError as error:  # a step beyond float64's reach
+        raise ValueError(
+            f"the Fréchet mean of these points of {manifold!r} cannot be computed in float64: "
+            "a Gauss–Newton step reached a point whose linear algebra fails "
+            f"({str(error).splitlines()[0]}). Points of extreme spread average exactly "
+            "when every point is diagonal (one eigenbasis); otherwise rescale or "
+            "regularise the series (add a multiple of the identity)"
+        ) from None
+
+
+def _frechet_mean(manifold, points, codes, sizes, weights, start, max_iter, tol,
+                  differentiate, warn):  # fmt: skip
     n_groups = sizes.numel()
     n_lead = points.ndim - 1 - manifold.point_ndim
     recording = torch.no_grad() if differentiate == "none" else contextlib.nullcontext()

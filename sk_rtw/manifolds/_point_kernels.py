@@ -31,6 +31,7 @@ module and a branch in the three functions below; a manifold without a kernel ki
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from numba import njit
@@ -72,6 +73,7 @@ def _layout(manifold: Manifold) -> list[tuple[int, int, int, int, int]] | None:
     segments = manifold.distance_segments
     if segments is None:
         return None
+    _check_tiling(manifold, segments)
     rows, offset = [], 0
     for start, stop, kind in segments:
         if kind == "spd" and stop - start in _SPD_BLOCKS:
@@ -84,6 +86,28 @@ def _layout(manifold: Manifold) -> list[tuple[int, int, int, int, int]] | None:
         rows.append((start, stop, offset, offset + width, code))
         offset += width
     return rows
+
+
+def _check_tiling(manifold: Manifold, segments: Any) -> None:
+    """The segments must cover the flat point once, in order: ``(0, a), (a, b), ...,
+    (c, size)``; otherwise the kernels would read past a point or skip coordinates."""
+    size = int(np.prod(manifold.point_shape))
+    expected = 0
+    for segment in segments:
+        start, stop, _ = segment
+        if start != expected or stop <= start or stop > size:
+            raise ValueError(
+                f"{manifold!r}.distance_segments = {tuple(segments)!r} do not cover its "
+                f"points' {size} coordinates once, in order: each segment (start, stop, "
+                f"kind) must start where the previous one stopped (the first at 0) and the "
+                f"last stop at {size}; segment {tuple(segment)!r} breaks that"
+            )
+        expected = stop
+    if expected != size:
+        raise ValueError(
+            f"{manifold!r}.distance_segments = {tuple(segments)!r} cover coordinates 0 to "
+            f"{expected} of its points' {size}: the distance would ignore the rest"
+        )
 
 
 def segment_codes(manifold: Manifold) -> np.ndarray | None:

@@ -227,6 +227,12 @@ def get_manifold(
                 f"{manifold!r} ({spec.description})"
             )
     result = spec.factory(dim)
+    if not isinstance(result, Manifold):
+        raise TypeError(
+            f"the factory of the registered manifold {key!r} returned a "
+            f"{type(result).__name__}, not a Manifold: ManifoldSpec.factory must build the "
+            "manifold object from a dimension (e.g. lambda d: MySpace(d))"
+        )
     if point_shape is not None:
         _check_point_shape(result, point_shape)
     return result

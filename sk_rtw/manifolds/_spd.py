@@ -65,10 +65,28 @@ class SPD(Manifold):
 
     def _velocity(self, p, x):
         # logm of the whitened matrix, in the isometric coordinates of _to_coordinates
-        si = symmetric_function(distinct(p), "invsqrt")
-        w = symmetric_function(sym(si @ x @ si), "log")
+        if _in_unit_range(p) and _in_unit_range(x):
+            w = self._whitened_log(p, x)
+        else:
+            # points far from 1: logm(p^-1/2 x p^-1/2) = logm(p'^-1/2 x' p'^-1/2) + (f - e)
+            # ln 2 I for p = 2^e p', x = 2^f x' (the whitening would over- or underflow);
+            # diagonal pairs entry by entry, exact at any spread
+            diagonal = (_is_diagonal(p) & _is_diagonal(x))[..., None, None]
+            eye = torch.eye(self.dim, dtype=p.dtype, device=p.device)
+            p_exponent, x_exponent = _scale_exponent(p), _scale_exponent(x)
+            shift = ((x_exponent - p_exponent) * math.log(2.0))[..., None, None]
+            rescaled = self._whitened_log(
+                torch.where(diagonal, eye, _unscaled(p, p_exponent)),
+                torch.where(diagonal, eye, _unscaled(x, x_exponent)),
+            ) + shift * eye
+            exact = torch.diag_embed(_log_entries(x) - _log_entries(p))
+            w = torch.where(diagonal, exact, rescaled)
         rows, cols, weight = self._triangle(w)
         return w[..., rows, cols] * weight
+
+    def _whitened_log(self, p, x):
+        si = symmetric_function(distinct(p), "invsqrt")
+        return symmetric_function(sym(si @ x @ si), "log")
 
     def _triangle(self, like):
         """Upper-triangle indices and their weights: 1 on the diagonal, sqrt(2) off it."""
