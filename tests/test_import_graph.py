@@ -145,7 +145,6 @@ BENCHMARKS = ROOT.parent / "benchmarks"
 #: (``docs/benchmarks/studies.md``): every other script uses the public API.
 PRIVATE_READERS = {
     "studies/candidates.py": "every candidate's held-out outcome per series (the choice's steps)",
-    "studies/forest_measures.py": "the forest's measure family swapped for a variant",
 }
 
 
@@ -207,7 +206,7 @@ def test_the_private_import_finder_finds_them(tmp_path):
     assert not any("dtw" in name for name in found)  # a mention is no import
 
 
-def test_benchmarks_use_the_public_api_but_two_studies():
+def test_benchmarks_use_the_public_api_but_one_study():
     readers = sorted(
         str(path.relative_to(BENCHMARKS))
         for path in BENCHMARKS.rglob("*.py")

@@ -435,7 +435,8 @@ def test_a_space_written_with_exp_and_log_only_is_checked_aligned_and_classified
     SO2 = PlaneRotations()
     angles = np.random.default_rng(0).uniform(-2.5, 2.5, 8)
     passed = check_manifold(SO2, rotations(angles))
-    assert len(passed) == 16  # every property; tangent coordinates skipped (not defined)
+    assert len(passed) == 17  # every property; tangent coordinates and the compiled
+    # distance skipped (not defined)
     # distance derived as the norm of the log: sqrt(2) times the angle between rotations
     assert SO2.dist(rotations(0.1), rotations(0.6)) == pytest.approx(np.sqrt(2) * 0.5)
     # the same demonstrations as unit vectors of S^1: the same geometry, the same mean
