@@ -3,7 +3,7 @@
 Align, average and classify time series whose samples live on Riemannian manifolds.
 """
 
-from . import baselines, datasets, forest, methods, metrics, statistics
+from . import baselines, datasets, forest, methods, metrics, shapelets, statistics
 
 # ``sk_rtw.align`` is the function (the paper's verb, ``sk_rtw.align(X, manifold=...)``):
 # as an attribute the name shadows the engine's package, whose records are therefore
@@ -43,6 +43,7 @@ from .manifolds import (
 )
 from .methods import DBA, NTW, RTW, TTW
 from .representations import tangent_velocity
+from .shapelets import GeodesicShapeletClassifier, GeodesicShapeletTransform
 from .statistics import AlignedStatistics, ConfidenceTube, aligned_statistics
 
 __version__ = "0.1.0.dev0"
@@ -59,6 +60,8 @@ __all__ = [
     "ConfidenceTube",
     "ElasticSplitter",
     "Euclidean",
+    "GeodesicShapeletClassifier",
+    "GeodesicShapeletTransform",
     "Manifold",
     "NTWAverager",
     "NTWNearestCentroid",
@@ -88,6 +91,7 @@ __all__ = [
     "get_manifold",
     "methods",
     "metrics",
+    "shapelets",
     "statistics",
     "tangent_velocity",
 ]

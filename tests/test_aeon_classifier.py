@@ -19,7 +19,8 @@ from aeon.testing.estimator_checking._yield_multithreading_checks import (
 from aeon.testing.testing_data import FULL_TEST_DATA_DICT
 
 from benchmarks.ucr._data import available_datasets, load_split
-from sk_rtw import DBA, RTW, RTWNearestCentroid, RTWProximityForest
+from sk_rtw import DBA, RTW, GeodesicShapeletClassifier, RTWNearestCentroid, RTWProximityForest
+from sk_rtw.aeon import GeodesicShapeletClassifier as AeonShapelets
 from sk_rtw.aeon import RTWClassifier, RTWProximityForestClassifier
 from sk_rtw.manifolds import Quaternion
 from sk_rtw.utils import from_aeon, to_aeon
@@ -174,3 +175,28 @@ def test_forest_on_quaternion_channels():
     forest = RTWProximityForestClassifier("quaternion", n_trees=5, random_state=0).fit(X, y)
     assert forest.estimator_.manifold_ == Quaternion()
     assert forest.predict(X).shape == (12,)
+
+
+# ------------------------------------------------------------- the shapelets
+@parametrize_with_checks([AeonShapelets])
+def test_aeon_estimator_checks_of_the_shapelets(check):
+    check()
+
+
+def test_shapelet_signature_is_the_classifiers():
+    ours = inspect.signature(AeonShapelets).parameters
+    theirs = inspect.signature(GeodesicShapeletClassifier).parameters
+    assert list(ours) == list(theirs)
+    assert {n for n in ours if ours[n].default != theirs[n].default} == {"n_jobs"}
+
+
+@pytest.mark.parametrize("channels", [1, 3])
+def test_same_predictions_as_the_shapelet_classifier(channels):
+    rng = np.random.default_rng(4)
+    X = np.stack(_walks(rng, 20, channels, [30] * 20))
+    X = X + (np.arange(20) % 2)[:, None, None] * np.linspace(0, 4, 30)
+    y = np.array(["up" if i % 2 else "flat" for i in range(20)])
+    params = {"n_shapelets": 40, "random_state": 0}
+    ours = AeonShapelets(**params).fit(X[:14], y[:14])
+    plain = GeodesicShapeletClassifier(**params).fit(from_aeon(X[:14]), y[:14])
+    np.testing.assert_array_equal(ours.predict(X[14:]), plain.predict(from_aeon(X[14:])))

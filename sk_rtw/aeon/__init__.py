@@ -1,6 +1,6 @@
 """aeon-native entry points: sk_rtw's classifiers as aeon estimators
 (:class:`RTWClassifier`, the nearest-centroid classifier; :class:`RTWProximityForestClassifier`,
-the proximity forest).
+the proximity forest; :class:`GeodesicShapeletClassifier`, the shapelets).
 
 For researchers who work in aeon (and tsml-eval): data as ``load_classification``
 returns them, ``(n_cases, n_channels, n_timepoints)`` or a list of ``(n_channels, T_i)``
@@ -19,5 +19,6 @@ except ImportError as exc:  # pragma: no cover - exercised without aeon only
 
 from ._classifier import RTWClassifier
 from ._forest import RTWProximityForestClassifier
+from ._shapelets import GeodesicShapeletClassifier
 
-__all__ = ["RTWClassifier", "RTWProximityForestClassifier"]
+__all__ = ["GeodesicShapeletClassifier", "RTWClassifier", "RTWProximityForestClassifier"]

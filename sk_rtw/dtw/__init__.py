@@ -13,7 +13,8 @@ midpoints) and :func:`soft_dtw_batch` (soft-DTW values and expected alignments).
 :func:`dtw_nearest_distance` finds the nearest series of every group with lower bounds
 and early abandoning; :func:`prepare_series` puts a collection in the kernels' form once
 for many searches on the calling thread (:func:`nearest_group`, and
-:func:`mean_diagonal_cost`, the scale of amerced DTW's penalty).
+:func:`mean_diagonal_cost`, the scale of amerced DTW's penalty). :func:`window_distances`
+and :func:`shapelet_features` slide a shapelet over windows of series (``_sliding``).
 
 The modules stand on floors, each importing only those below it: the compiled point
 costs (``_point_costs``, rows of costs from the manifolds' point geometry, which is the
@@ -30,8 +31,10 @@ from ._costs import optimal_path, point_cost_matrix
 from ._dtw import check_window, dtw_cost_matrix, dtw_distance, dtw_pairwise_distance, dtw_path
 from ._medoid import medoid_index
 from ._paths import has_compiled_costs, mean_matched_positions, path_indices
+from ._point_costs import kernel_point_form
 from ._prepared import EXPONENTS, PreparedSeries, mean_diagonal_cost, nearest_group, prepare_series
 from ._search import dtw_nearest_distance
+from ._sliding import shapelet_features, window_distances, window_profiles
 from ._soft import soft_dtw_batch
 
 __all__ = [
@@ -45,6 +48,7 @@ __all__ = [
     "dtw_pairwise_distance",
     "dtw_path",
     "has_compiled_costs",
+    "kernel_point_form",
     "mean_diagonal_cost",
     "mean_matched_positions",
     "medoid_index",
@@ -54,6 +58,9 @@ __all__ = [
     "path_indices",
     "point_cost_matrix",
     "prepare_series",
+    "shapelet_features",
     "soft_dtw_batch",
     "solved_exactly",
+    "window_distances",
+    "window_profiles",
 ]

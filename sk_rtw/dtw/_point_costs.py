@@ -31,7 +31,26 @@ from ..manifolds._point_kernels import (
 # edit there (numba itself watches only each kernel's own file)
 drop_stale_caches(Path(__file__).parent, _point_kernels.compiled_sources())
 
-__all__ = ["FLAT", "kernel_points", "kernel_series", "robust_distance", "segment_codes"]
+__all__ = [
+    "FLAT",
+    "kernel_point_form",
+    "kernel_points",
+    "kernel_series",
+    "robust_distance",
+    "segment_codes",
+]
+
+
+def kernel_point_form(manifold, points: np.ndarray) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """Points ``(..., *point_shape)`` of ``manifold`` in the kernels' form ``(..., q)``,
+    C-contiguous, and the manifold's segment codes; ``(None, None)`` where it has no
+    kernel form."""
+    segments = segment_codes(manifold)
+    if segments is None:
+        return None, None
+    lead = points.shape[: points.ndim - len(manifold.point_shape)]
+    flat = np.asarray(points, dtype=np.float64).reshape(*lead, -1)
+    return np.ascontiguousarray(kernel_points(manifold, flat)), segments
 
 
 def kernel_series(collection) -> np.ndarray:

@@ -534,6 +534,34 @@ class Manifold(ABC):
         leading axes): geodesics that long wrap round (a sphere) or stop being shortest."""
         return self._norm(p, v) > self.injectivity_radius
 
+    @property
+    def normalised_space(self) -> Manifold | None:
+        """The space of :meth:`normalise_windows`' points, or None where the manifold
+        has no form of z-normalisation (then shapelets compare windows as they are)."""
+        return None
+
+    def normalise_windows(self, windows: np.ndarray) -> np.ndarray:
+        """Windows of points with the manifold's group action removed: the manifold's
+        form of z-normalisation, for shapelets that compare shape without position.
+
+        A window recorded in another frame (the group acting on every point alike)
+        gives the same normalised window: R^d subtracts each coordinate's mean and
+        divides by its standard deviation (an affine map per coordinate); unit
+        quaternions left-multiply by the inverse of the window's chordal mean (a
+        rotation of the world frame); SPD(k) takes each point's log-eigenvalues
+        relative to the window's arithmetic mean (any congruence ``A X A^T``); a
+        product normalises each factor.
+
+        Parameters
+        ----------
+        windows : ndarray of shape (..., length, *point_shape)
+
+        Returns
+        -------
+        ndarray of shape (..., length, *normalised_space.point_shape)
+        """
+        raise NotImplementedError(f"{self!r} has no form of z-normalisation")
+
     def spread_note(self, points: np.ndarray) -> str:
         """A few words on the range of ``points`` for error messages ("" if none apply).
 

@@ -9,6 +9,10 @@ import numpy as np
 from .._backend import safe_norm
 from ._base import Manifold, power_of_two_scale
 
+#: A window coordinate whose standard deviation is below this is only centred (aeon's
+#: z-normalisation threshold).
+STD_FLOOR = 1e-8
+
 
 @dataclass(frozen=True)
 class Euclidean(Manifold):
@@ -62,6 +66,17 @@ class Euclidean(Manifold):
 
     def _project(self, x):
         return x
+
+    @property
+    def normalised_space(self):
+        return self
+
+    def normalise_windows(self, windows):
+        # aeon's z-normalisation: a constant coordinate is only centred
+        windows = np.asarray(windows, dtype=np.float64)
+        mean = windows.mean(axis=-2, keepdims=True)
+        std = windows.std(axis=-2, keepdims=True)
+        return (windows - mean) / np.where(std > STD_FLOOR, std, 1.0)
 
     def extreme_scale(self, points):
         return power_of_two_scale(float(np.abs(points).max(initial=0.0)))

@@ -86,6 +86,25 @@ class Product(Manifold):
         )  # fmt: skip
 
     @property
+    def normalised_space(self):
+        spaces = [f.normalised_space for f in self.factors]
+        if any(space is None for space in spaces):
+            return None
+        return Product(tuple(spaces))
+
+    def normalise_windows(self, windows):
+        windows = np.asarray(windows, dtype=np.float64)
+        parts, offset = [], 0
+        for factor, size in zip(self.factors, self._sizes, strict=True):
+            part = windows[..., offset : offset + size]
+            part = part.reshape(*part.shape[:-1], *factor.point_shape)
+            normal = factor.normalise_windows(part)
+            width = int(np.prod(factor.normalised_space.point_shape))
+            parts.append(normal.reshape(*windows.shape[:-1], width))
+            offset += size
+        return np.concatenate(parts, axis=-1)
+
+    @property
     def distance_segments(self):
         segments, offset = [], 0
         for factor, size in zip(self.factors, self._sizes, strict=True):

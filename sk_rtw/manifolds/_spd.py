@@ -11,7 +11,7 @@ import torch
 from .._backend import safe_norm
 from . import _spd2
 from ._base import EXTREME_EXPONENT, Manifold, power_of_two_scale
-from ._euclidean import _check_dim
+from ._euclidean import Euclidean, _check_dim
 from ._mean import group_expand
 from ._symmetric import distinct, eigenvalues, sym, symmetric_function, symmetric_functions
 
@@ -112,6 +112,20 @@ class SPD(Manifold):
         w = w + w.mT - torch.diag_embed(torch.diagonal(w, dim1=-2, dim2=-1))
         s = symmetric_function(distinct(p), "sqrt")
         return sym(s @ w @ s)
+
+    @property
+    def normalised_space(self):
+        return Euclidean(self.dim)
+
+    def normalise_windows(self, windows):
+        # log-eigenvalues of M^-1 X (M the window's arithmetic mean, A M A^T for the
+        # window A X A^T): the same under any congruence; ascending
+        X = np.asarray(windows, dtype=np.float64)
+        lower = np.linalg.cholesky(X.mean(axis=-3, keepdims=True))
+        inverse = np.linalg.inv(lower)
+        relative = inverse @ X @ np.swapaxes(inverse, -1, -2)
+        relative = 0.5 * (relative + np.swapaxes(relative, -1, -2))
+        return np.log(np.clip(np.linalg.eigvalsh(relative), 1e-300, None))
 
     def _whiten(self, p):
         """``p^½`` and ``p^-½`` from one eigendecomposition of each distinct ``p``."""

@@ -304,6 +304,18 @@ class Quaternion(Sphere):
         return _sphere_dist(p, x, sign_invariant=True)
 
     @property
+    def normalised_space(self):
+        return self
+
+    def normalise_windows(self, windows):
+        # the chordal mean m (top eigenvector of sum q q^T: sign-free, and g m for the
+        # window g q), then conj(m) q: the same for a window in any world frame
+        q = np.asarray(windows, dtype=np.float64)
+        scatter = np.einsum("...ki,...kj->...ij", q, q)
+        mean = np.linalg.eigh(scatter)[1][..., :, -1][..., None, :]
+        return quaternion_product(quaternion_conjugate(mean), q)
+
+    @property
     def velocity_dim(self) -> int:
         return 3
 
@@ -314,3 +326,19 @@ class Quaternion(Sphere):
         w, a = p[..., :1], p[..., 1:]
         v0, b = v[..., :1], v[..., 1:]
         return 2.0 * (w * b - v0 * a - torch.linalg.cross(a.expand_as(b), b, dim=-1))
+
+
+def quaternion_conjugate(q: np.ndarray) -> np.ndarray:
+    """``(w, -x, -y, -z)``: the inverse of a unit quaternion."""
+    return q * np.array([1.0, -1.0, -1.0, -1.0])
+
+
+def quaternion_product(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Hamilton products ``a b`` of quaternions ``(w, x, y, z)``, broadcast."""
+    w1, v1 = a[..., :1], a[..., 1:]
+    w2, v2 = b[..., :1], b[..., 1:]
+    w = w1 * w2 - (v1 * v2).sum(-1, keepdims=True)
+    v = w1 * v2 + w2 * v1 + np.cross(v1, v2)
+    lead = np.broadcast_shapes(w.shape[:-1], v.shape[:-1])
+    return np.concatenate([np.broadcast_to(w, (*lead, 1)), np.broadcast_to(v, (*lead, 3))],
+                          axis=-1)  # fmt: skip

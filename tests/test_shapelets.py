@@ -1,0 +1,210 @@
+"""Geodesic dilated shapelets: features against brute force on every kind of space, the
+manifold's z-normalisation invariant to the frame, thresholds from the class, the
+scikit-learn rules, clear errors."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+from sklearn.base import clone
+from sklearn.model_selection import GridSearchCV
+from sklearn.utils.estimator_checks import parametrize_with_checks
+
+from sk_rtw import SPD, GeodesicShapeletClassifier, GeodesicShapeletTransform, Quaternion
+from sk_rtw.manifolds import Euclidean, Product, Sphere
+from sk_rtw.manifolds._sphere import quaternion_product
+
+from .test_dtw import random_walk
+from .test_estimators import EXPECTED_FAILURES
+
+
+def _expected_failures(estimator):
+    if isinstance(estimator, GeodesicShapeletTransform):  # features of any length
+        return {k: v for k, v in EXPECTED_FAILURES.items() if "transformer_general" not in k}
+    return EXPECTED_FAILURES
+
+
+@parametrize_with_checks(
+    [GeodesicShapeletTransform(n_shapelets=8, random_state=0),
+     GeodesicShapeletClassifier(n_shapelets=8, random_state=0)],
+    expected_failed_checks=_expected_failures,
+)
+def test_sklearn_compatible(estimator, check):
+    check(estimator)
+
+
+def _brute_features(transform, X, manifold):
+    """Every shapelet's three features with Python loops over windows and points: the
+    manifold's own distance, its own normalisation, the velocity by tangent_velocity."""
+    from sk_rtw import tangent_velocity
+
+    out = []
+    for x in X:
+        row = []
+        for s in transform.shapelets_:
+            if s.representation == "velocity":
+                series = np.asarray(tangent_velocity(x[None], manifold))[0]
+                space = Euclidean(series.shape[-1])
+                series = series.reshape(len(series), -1)
+            else:
+                series, space = x, manifold
+            span = (s.length - 1) * s.dilation
+            distances = []
+            for t in range(len(series) - span):
+                window = series[t + s.dilation * np.arange(s.length)]
+                compare = space
+                if s.normalised:
+                    window = space.normalise_windows(window[None])[0]
+                    compare = space.normalised_space
+                distances.append(sum(float(compare.dist(a, b))
+                                     for a, b in zip(s.points, window, strict=True)))  # fmt: skip
+            d = np.array(distances)
+            row += [d.min(), np.argmin(d), np.count_nonzero(d < s.threshold)]
+        out.append(row)
+    return np.array(out)
+
+
+@pytest.mark.parametrize(
+    "manifold",
+    [Euclidean(1), Euclidean(3), Sphere(2), Quaternion(), SPD(2), SPD(3),
+     Product((Euclidean(3), Quaternion()))],
+    ids=repr,
+)
+def test_features_are_the_brute_force_ones(manifold):
+    X = np.stack([random_walk(manifold, 30, s, step=0.3) for s in range(6)])
+    if manifold == Euclidean(1):
+        X = X[..., 0]
+    y = [0, 0, 0, 1, 1, 1]
+    transform = GeodesicShapeletTransform(manifold, n_shapelets=24, lengths=(3, 5),
+                                          random_state=0).fit(X, y)  # fmt: skip
+    kinds = {(s.representation, s.normalised) for s in transform.shapelets_}
+    if manifold.normalised_space is not None:
+        assert kinds == {("raw", True), ("raw", False), ("velocity", True),
+                         ("velocity", False)}  # fmt: skip
+    got = transform.transform(X[:3])
+    expected = _brute_features(transform, X[:3] if manifold != Euclidean(1) else X[:3, :, None],
+                               manifold)  # fmt: skip
+    np.testing.assert_allclose(got, expected, rtol=1e-9, atol=1e-9)
+
+
+def test_unequal_lengths_and_thresholds_from_the_class():
+    rng = np.random.default_rng(1)
+    X = [rng.standard_normal(n) for n in (30, 41, 35, 50, 33, 44)]
+    y = np.array([0, 1, 0, 1, 0, 1])
+    transform = GeodesicShapeletTransform(n_shapelets=30, lengths=(4,), representation="raw",
+                                          random_state=2).fit(X, y)  # fmt: skip
+    features = transform.transform(X).reshape(6, -1, 3)
+    for j, s in enumerate(transform.shapelets_):
+        series, start = s.source
+        assert y[series] == s.label
+        # where it was drawn from, its distance is 0 (not normalised) at its start
+        if not s.normalised:
+            assert features[series, j, 0] == pytest.approx(0.0, abs=1e-12)
+            assert features[series, j, 1] == start
+    assert np.all(features[..., 2] >= 0)
+    assert transform.get_feature_names_out()[:3].tolist() == [
+        "shapelet0_min", "shapelet0_argmin", "shapelet0_count"]  # fmt: skip
+
+
+def _rotated_quaternions(Q, seed):
+    rng = np.random.default_rng(seed)
+    out = []
+    for q in Q:
+        g = Rotation.random(random_state=rng.integers(1 << 31)).as_quat()[[3, 0, 1, 2]]
+        sign = rng.choice([-1.0, 1.0])
+        out.append(sign * quaternion_product(g, q))
+    return np.stack(out)
+
+
+def test_normalised_quaternion_shapelets_do_not_see_the_world_frame():
+    """Each demonstration in its own world frame (a random rotation and sign per
+    series): the normalised features do not change; the raw ones do."""
+    Q = np.stack([random_walk(Quaternion(), 25, s, step=0.2) for s in range(6)])
+    y = [0, 0, 0, 1, 1, 1]
+    normal = GeodesicShapeletTransform("quaternion", n_shapelets=20, normalised_fraction=1.0,
+                                       representation="raw", random_state=0).fit(Q, y)  # fmt: skip
+    moved = _rotated_quaternions(Q, 3)
+    np.testing.assert_allclose(normal.transform(moved), normal.transform(Q), atol=1e-9)
+    raw = GeodesicShapeletTransform("quaternion", n_shapelets=20, normalised_fraction=0.0,
+                                    representation="raw", random_state=0).fit(Q, y)  # fmt: skip
+    assert not np.allclose(raw.transform(moved), raw.transform(Q), atol=1e-3)
+    # the body-frame velocity does not see it either
+    velocity = GeodesicShapeletTransform("quaternion", n_shapelets=20, random_state=0,
+                                         representation="velocity").fit(Q, y)  # fmt: skip
+    np.testing.assert_allclose(velocity.transform(moved), velocity.transform(Q), atol=1e-9)
+
+
+def test_normalised_spd_shapelets_do_not_see_a_congruence():
+    S = np.stack([random_walk(SPD(3), 20, s, step=0.3) for s in range(6)])
+    y = [0, 0, 0, 1, 1, 1]
+    A = np.random.default_rng(4).standard_normal((3, 3))
+    rotation = Rotation.random(random_state=5).as_matrix()
+    normal = GeodesicShapeletTransform("spd", n_shapelets=20, normalised_fraction=1.0,
+                                       representation="raw", random_state=0).fit(S, y)  # fmt: skip
+    for moved in (A @ S @ A.T, rotation @ S @ rotation.T):
+        np.testing.assert_allclose(normal.transform(moved), normal.transform(S), atol=1e-8)
+
+
+def test_the_classifier_reads_local_patterns_and_is_deterministic():
+    """A bump at a random place marks class 1: the shapelets see it where the whole
+    series (1-NN Euclidean) mostly sees noise."""
+    from sklearn.neighbors import KNeighborsClassifier
+
+    rng = np.random.default_rng(0)
+    X = rng.standard_normal((60, 60))
+    where = rng.integers(0, 50, size=60)
+    y = np.arange(60) % 2
+    for i in np.flatnonzero(y):
+        X[i, where[i] : where[i] + 8] += np.hanning(8) * 6
+    nearest = KNeighborsClassifier(1).fit(X[:30], y[:30]).score(X[30:], y[30:])
+    scores = [GeodesicShapeletClassifier(n_shapelets=200, random_state=seed)
+              .fit(X[:30], y[:30]).score(X[30:], y[30:]) for seed in range(3)]  # fmt: skip
+    assert np.mean(scores) >= 0.85 and np.mean(scores) > nearest + 0.05
+    X, y = X[:40], y[:40]
+    clf = GeodesicShapeletClassifier(n_shapelets=200, random_state=0).fit(X[:24], y[:24])
+    again = GeodesicShapeletClassifier(n_shapelets=200, random_state=0, n_jobs=2)
+    np.testing.assert_array_equal(again.fit(X[:24], y[:24]).decision_function(X[24:]),
+                                  clf.decision_function(X[24:]))  # fmt: skip
+    proba = clf.predict_proba(X[24:])
+    np.testing.assert_array_equal(clf.classes_[proba.argmax(1)], clf.predict(X[24:]))
+    grid = GridSearchCV(GeodesicShapeletClassifier(n_shapelets=50, random_state=0),
+                        {"normalised_fraction": [0.0, 1.0]}, cv=2).fit(X, y)  # fmt: skip
+    assert grid.best_score_ > 0.5
+    assert clone(clf).get_params()["n_shapelets"] == 200
+
+
+def test_bad_input_is_named():
+    rng = np.random.default_rng(0)
+    X = rng.standard_normal((6, 12))
+    y = [0, 1, 0, 1, 0, 1]
+    with pytest.raises(ValueError, match="longer than the shortest training series"):
+        GeodesicShapeletTransform(lengths=(13,)).fit(X, y)
+    with pytest.raises(ValueError, match="velocity one fewer"):
+        GeodesicShapeletTransform(lengths=(12,)).fit(X, y)
+    fitted = GeodesicShapeletTransform(n_shapelets=10, lengths=(6,), representation="raw",
+                                       random_state=0).fit(X, y)  # fmt: skip
+    with pytest.raises(ValueError, match=r"series 0 has 3 time points; the shapelets span"):
+        fitted.transform(X[:, :3])
+    with pytest.raises(ValueError, match="NaN"):
+        GeodesicShapeletTransform().fit(np.where(X > 1, np.nan, X), y)
+    with pytest.raises(ValueError, match="not a point"):
+        GeodesicShapeletTransform("sphere").fit(np.ones((4, 8, 3)))
+    for params, name in (({"n_shapelets": 0}, "n_shapelets"), ({"lengths": (0,)}, "lengths"),
+                         ({"normalised_fraction": 1.5}, "normalised_fraction"),
+                         ({"threshold_percentiles": (10, 5)}, "threshold_percentiles"),
+                         ({"representation": "both-ways"}, "representation")):  # fmt: skip
+        with pytest.raises((ValueError, TypeError), match=name):
+            GeodesicShapeletTransform(**params).fit(X, y)
+    with pytest.raises(ValueError, match="2 classes"):
+        GeodesicShapeletClassifier(n_shapelets=5).fit(X, [0] * 6)
+    # a class of one series: its shapelets' thresholds come from that series itself
+    one = GeodesicShapeletTransform(n_shapelets=20, random_state=0).fit(X[:3], [0, 0, 1])
+    assert np.isfinite(one.transform(X)).all()
+
+
+def test_a_sphere_without_normalisation_draws_raw_shapelets_only():
+    S = np.stack([random_walk(Sphere(2), 20, s, step=0.3) for s in range(4)])
+    transform = GeodesicShapeletTransform("sphere", n_shapelets=20, normalised_fraction=1.0,
+                                          representation="raw", random_state=0).fit(S)  # fmt: skip
+    assert not any(s.normalised for s in transform.shapelets_)
