@@ -191,3 +191,72 @@ def test_a_tree_alone_and_in_a_forest_grow_from_the_same_seed_the_same_way():
     member = forest.trees_[0]
     assert member.classes_ is forest.classes_ and member.manifold_ == forest.manifold_
     np.testing.assert_array_equal(member.predict(X), y)
+
+
+# ------------------------------------------------------------- shapelet splits
+def test_the_best_threshold_is_the_brute_force_one():
+    from sk_rtw.forest import gini_gain
+    from sk_rtw.forest._shapelet import best_threshold
+
+    rng = np.random.default_rng(0)
+    for _ in range(20):
+        values = rng.integers(0, 6, size=15).astype(float)
+        codes = rng.integers(0, 3, size=15)
+        threshold, gain = best_threshold(values, codes, 3)
+        candidates = np.unique(values)
+        gains = [gini_gain(codes, (values > c).astype(int), 2, 3) for c in candidates[:-1]]
+        assert gain == pytest.approx(max(gains))
+        assert gini_gain(codes, (values > threshold).astype(int), 2, 3) == pytest.approx(gain)
+    assert np.isnan(best_threshold(np.ones(4), np.array([0, 1, 0, 1]), 2)[0])
+
+
+def test_a_shapelet_split_routes_new_series_as_it_split_the_node():
+    from sk_rtw.forest import (
+        NodeSeries,
+        SeriesSet,
+        SeriesView,
+        ShapeletSplit,
+        ShapeletSplitter,
+        TrainingSet,
+    )
+    from sk_rtw.utils import check_series_collection
+
+    X, y = three_classes()
+    codes = np.searchsorted(np.unique(y), y)
+    collection = check_series_collection(X)
+    training = TrainingSet.build(collection, ("raw", "velocity"), codes, 3)
+    splitter = ShapeletSplitter().resolved({"n_candidates": 1, "representation": "both"})
+    indices = np.arange(3, 24)
+    for seed in range(8):
+        node = NodeSeries(training, indices, codes[indices])
+        split, branches = splitter.candidate(node, np.random.default_rng(seed))
+        assert isinstance(split, ShapeletSplit)
+        np.testing.assert_array_equal(split.route(node.series), branches)
+        again = SeriesView(SeriesSet.build(collection, ("raw", "velocity")), indices)
+        np.testing.assert_array_equal(split.route(again), branches)
+        assert split.shapelet.source[0] in indices  # drawn from the node's series
+        assert str(split).split()[0] in ("min", "argmin", "count")
+
+
+def test_shapelet_splits_find_a_local_pattern():
+    """A bump at a random place marks class 1: shapelet splits alone find it, and mixed
+    with the elastic ones they are kept where they split best."""
+    from sk_rtw.forest import ShapeletSplitter
+
+    rng = np.random.default_rng(0)
+    X = rng.standard_normal((80, 60))
+    where = rng.integers(0, 50, size=80)
+    y = np.arange(80) % 2
+    for i in np.flatnonzero(y):
+        X[i, where[i] : where[i] + 8] += np.hanning(8) * 6
+    alone = RTWProximityForest(n_trees=20, random_state=0, splitters=[ShapeletSplitter()])
+    assert alone.fit(X[:40], y[:40]).score(X[40:], y[40:]) >= 0.8
+    mixed = RTWProximityForest(n_trees=20, random_state=0,
+                               splitters=[ElasticSplitter(), ShapeletSplitter()])  # fmt: skip
+    assert mixed.fit(X[:40], y[:40]).score(X[40:], y[40:]) >= 0.9
+    kinds = {type(t.root_.split).__name__ for t in mixed.trees_}
+    assert "ShapeletSplit" in kinds
+    with pytest.raises(ValueError, match="lengths"):
+        RTWProximityForest(n_trees=1, splitters=[ShapeletSplitter(lengths=(99,))]).fit(X, y)
+    with pytest.raises(ValueError, match="features"):
+        RTWProximityForest(n_trees=1, splitters=[ShapeletSplitter(features=("max",))]).fit(X, y)

@@ -2,14 +2,15 @@
 
 Floors, from the bottom: ``_gini`` and ``_series`` (what a node is scored by and the
 series it reads) import nothing of the package's forest; ``_splitter`` (the protocol),
-then the kinds of split (``_elastic``), ``_params`` (the parameters the tree and the
+then the kinds of split (``_elastic``, ``_shapelet``), ``_params`` (the parameters the tree and the
 forest share), ``_tree``, ``_forest``. This module is the only door.
 """
 
 from ._elastic import ElasticSplitter, Measure, NearestExemplarSplit
 from ._forest import RTWProximityForest
 from ._gini import gini, gini_gain
-from ._series import NodeSeries, SeriesView, TrainingSet
+from ._series import NodeSeries, SeriesSet, SeriesView, TrainingSet
+from ._shapelet import ShapeletSplit, ShapeletSplitter
 from ._splitter import Split, Splitter
 from ._tree import ProximityNode, ProximityTree
 
@@ -21,7 +22,10 @@ __all__ = [
     "ProximityNode",
     "ProximityTree",
     "RTWProximityForest",
+    "SeriesSet",
     "SeriesView",
+    "ShapeletSplit",
+    "ShapeletSplitter",
     "Split",
     "Splitter",
     "TrainingSet",

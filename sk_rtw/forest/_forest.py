@@ -243,7 +243,7 @@ class RTWProximityForest(ClassifierMixin, BaseEstimator):
         """
         check_is_fitted(self, "trees_")
         data = prepare_representations(X, self.manifold_, self.representations_, self.scale_)
-        n = next(iter(data.values())).n_series
+        n = data.n_series
         with limited_threads(1):
             votes = thread_map(lambda tree: tree._proba(data, n), self.trees_,
                                resolve_n_jobs(self.n_jobs))  # fmt: skip

@@ -16,23 +16,43 @@ from ..utils import SeriesCollection
 
 
 @dataclass(frozen=True, eq=False)
-class TrainingSet:
-    """The training series in every representation a forest's splitters read
-    (``collections``: validated series, for averaging; ``prepared``: the same in the DTW
-    kernels' form, for the searches), with their class codes."""
+class SeriesSet:
+    """Series in every representation the splits read: ``collections`` (validated, as
+    points: for averaging and for windows) and ``prepared`` (the same in the DTW
+    kernels' form, for the searches)."""
 
     collections: Mapping[str, SeriesCollection]
     prepared: Mapping[str, PreparedSeries]
+
+    @staticmethod
+    def represented(
+        collection: SeriesCollection, representations: tuple[str, ...]
+    ) -> tuple[dict[str, SeriesCollection], dict[str, PreparedSeries]]:
+        collections = {r: represent(collection, r) for r in representations}
+        return collections, {r: prepare_series(c) for r, c in collections.items()}
+
+    @classmethod
+    def build(cls, collection: SeriesCollection, representations: tuple[str, ...]) -> SeriesSet:
+        return cls(*cls.represented(collection, representations))
+
+    @property
+    def n_series(self) -> int:
+        return next(iter(self.prepared.values())).n_series
+
+
+@dataclass(frozen=True, eq=False)
+class TrainingSet(SeriesSet):
+    """The training series (a :class:`SeriesSet`) with their class codes."""
+
     codes: np.ndarray
     n_classes: int
 
     @classmethod
-    def build(
+    def build(  # type: ignore[override]
         cls, collection: SeriesCollection, representations: tuple[str, ...],
         codes: np.ndarray, n_classes: int,
     ) -> TrainingSet:  # fmt: skip
-        collections = {r: represent(collection, r) for r in representations}
-        prepared = {r: prepare_series(c) for r, c in collections.items()}
+        collections, prepared = cls.represented(collection, representations)
         return cls(collections, prepared, np.asarray(codes), int(n_classes))
 
 
@@ -53,24 +73,36 @@ def unit_frame(collection: SeriesCollection, scale: float | None = None) -> tupl
 
 
 class SeriesView(Mapping[str, PreparedSeries]):
-    """Series ``indices`` of ``data`` per representation, taken the first time a
-    representation is read (a split reads one or two of them)."""
+    """Series ``indices`` of a :class:`SeriesSet`: ``view[representation]`` in the DTW
+    kernels' form, :meth:`collection` as points, each taken the first time it is read (a
+    split reads one or two representations)."""
 
-    def __init__(self, data: Mapping[str, PreparedSeries], indices: np.ndarray) -> None:
-        self._data = data
+    def __init__(self, series: SeriesSet, indices: np.ndarray) -> None:
+        self._series = series
         self.indices = indices
         self._taken: dict[str, PreparedSeries] = {}
+        self._collections: dict[str, SeriesCollection] = {}
 
     def __getitem__(self, representation: str) -> PreparedSeries:
         if representation not in self._taken:
-            self._taken[representation] = self._data[representation].take(self.indices)
+            self._taken[representation] = self._series.prepared[representation].take(
+                self.indices
+            )
         return self._taken[representation]
 
+    def collection(self, representation: str) -> SeriesCollection:
+        """The series in ``representation`` as points of its manifold."""
+        if representation not in self._collections:
+            self._collections[representation] = self._series.collections[
+                representation
+            ].subset(self.indices)
+        return self._collections[representation]
+
     def __iter__(self):
-        return iter(self._data)
+        return iter(self._series.prepared)
 
     def __len__(self) -> int:
-        return len(self._data)
+        return len(self._series.prepared)
 
     @property
     def n_series(self) -> int:
@@ -92,7 +124,7 @@ class NodeSeries:
     memo: dict[Any, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        self.series = SeriesView(self.training.prepared, self.indices)
+        self.series = SeriesView(self.training, self.indices)
 
     @property
     def n_classes(self) -> int:

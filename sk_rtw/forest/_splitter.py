@@ -64,3 +64,13 @@ class Splitter(BaseEstimator, ABC):
     @abstractmethod
     def draw(self, node: NodeSeries, rng: np.random.Generator) -> Split:
         """One candidate split of ``node`` (of a resolved splitter)."""
+
+    def candidate(
+        self, node: NodeSeries, rng: np.random.Generator
+    ) -> tuple[Split, np.ndarray]:
+        """One candidate and the branch of every series of ``node``: :meth:`draw`, then
+        :meth:`Split.route` of the node's series. A kind whose draw already computes the
+        branches (a threshold chosen on the node's values) returns them instead of
+        routing twice; they must equal what ``route`` gives."""
+        split = self.draw(node, rng)
+        return split, split.route(node.series)

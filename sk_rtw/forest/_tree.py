@@ -15,7 +15,6 @@ which kind a split is.
 from __future__ import annotations
 
 import time
-from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -24,8 +23,6 @@ from sklearn.base import BaseEstimator, ClassifierMixin
 from sklearn.utils.validation import check_is_fitted
 
 from .._random import check_generator
-from ..dtw import PreparedSeries, prepare_series
-from ..representations import represent
 from ..utils import check_classes, check_series_collection
 from ..utils._common_params import MANIFOLD, RANDOM_STATE
 from ..utils._params import declare_parameters, validate_parameters
@@ -39,7 +36,7 @@ from ._params import (
     representations_read,
     resolve_splitters,
 )
-from ._series import NodeSeries, SeriesView, TrainingSet, unit_frame
+from ._series import NodeSeries, SeriesSet, SeriesView, TrainingSet, unit_frame
 from ._splitter import Split, Splitter
 
 if TYPE_CHECKING:
@@ -89,8 +86,7 @@ def best_split(
     best: tuple[Split, float, np.ndarray] | None = None
     for splitter in splitters:
         for _ in range(splitter.n_candidates or 0):
-            split = splitter.draw(node, rng)
-            branches = split.route(node.series)
+            split, branches = splitter.candidate(node, rng)
             gain = gini_gain(node.codes, branches, split.n_branches, node.n_classes)
             if best is None or gain > best[1]:
                 best = split, gain, branches
@@ -260,9 +256,9 @@ class ProximityTree(ClassifierMixin, BaseEstimator):
         self.seconds_ = time.perf_counter() - start
         return self
 
-    def _proba(self, data: Mapping[str, PreparedSeries], n_series: int) -> np.ndarray:
-        """Class proportions of the leaf every series reaches (``data``: the series
-        prepared in every representation the splits read)."""
+    def _proba(self, data: SeriesSet, n_series: int) -> np.ndarray:
+        """Class proportions of the leaf every series reaches (``data``: the series in
+        every representation the splits read)."""
         out = np.empty((n_series, len(self.root_.distribution)))
         stack = [(self.root_, np.arange(n_series))]
         while stack:
@@ -290,7 +286,7 @@ class ProximityTree(ClassifierMixin, BaseEstimator):
         """
         check_is_fitted(self, "root_")
         data = prepare_representations(X, self.manifold_, self.representations_, self.scale_)
-        return self._proba(data, next(iter(data.values())).n_series)
+        return self._proba(data, data.n_series)
 
     def predict(self, X: Any) -> np.ndarray:
         """The class of the largest :meth:`predict_proba` (ties to the first class).
@@ -315,9 +311,9 @@ class ProximityTree(ClassifierMixin, BaseEstimator):
 
 def prepare_representations(
     X: Any, manifold: Manifold, representations: tuple[str, ...], scale: float
-) -> dict[str, PreparedSeries]:
+) -> SeriesSet:
     """Series to route: validated on the training ``manifold``, divided by the training
     set's ``scale`` and prepared once in every representation the splits read."""
     shortest = 2 if "velocity" in representations else 1
     collection, _ = unit_frame(check_series_collection(X, manifold, min_length=shortest), scale)
-    return {r: prepare_series(represent(collection, r)) for r in representations}
+    return SeriesSet.build(collection, representations)

@@ -9,7 +9,7 @@ door; the forest's shapelet splits draw and score shapelets through it.
 
 from ._classifier import GeodesicShapeletClassifier
 from ._shapelet import FEATURES, Shapelet, ShapeletBank, draw_shapelets, features, profile
-from ._transform import GeodesicShapeletTransform
+from ._transform import GeodesicShapeletTransform, default_length
 from ._windows import Windows, gather_windows, window_space
 
 __all__ = [
@@ -19,6 +19,7 @@ __all__ = [
     "Shapelet",
     "ShapeletBank",
     "Windows",
+    "default_length",
     "draw_shapelets",
     "features",
     "gather_windows",
