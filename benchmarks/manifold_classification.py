@@ -15,7 +15,15 @@ demonstration ``k`` of every shape and trains on the other three (4 folds, 30 cl
   the body angular velocity of the quaternions, the whitened logarithm of the SPD steps;
   Euclidean point cost, no band);
 * ``minirocket``: aeon's ``MiniRocketClassifier`` on the coordinates (the 4 quaternion
-  components; the 3 distinct entries of a 2 x 2 SPD matrix), which knows no manifold.
+  components; the 3 distinct entries of a 2 x 2 SPD matrix), which knows no manifold;
+* ``shapelets``: ``GeodesicShapeletClassifier(manifold=...)``, the library's defaults;
+* ``forest-shapelets``: the forest with elastic and shapelet candidates
+  (``splitters=[ElasticSplitter(), ShapeletSplitter()]``).
+
+``--frames`` puts every demonstration in a world frame of its own, as a robot's
+demonstrations recorded in different frames: a random rotation and sign per
+quaternion series (``q -> +-g q``), a congruence by a random rotation per SPD series
+(``X -> R X R^T``); the seed of the frames is ``--seed``.
 
 Usage::
 
@@ -32,6 +40,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 if __package__ in (None, ""):
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
@@ -39,15 +48,36 @@ if __package__ in (None, ""):
 from benchmarks._shared import check_writable, machine, method_object
 from benchmarks.paper._data import data_dir, rlasa_quaternions, rlasa_shapes, rlasa_spd
 from sk_rtw import (
+    ElasticSplitter,
+    GeodesicShapeletClassifier,
     RTWNearestCentroid,
     RTWPrototypeClassifier,
     RTWProximityForest,
+    ShapeletSplitter,
     dtw_pairwise_distance,
     tangent_velocity,
 )
+from sk_rtw.manifolds import quaternion_product
 
 SPACES = ("quaternion", "spd")
-ROWS = ("prototype", "nearest-centroid", "forest", "1nn-dtw", "1nn-dtw-velocity", "minirocket")
+ROWS = ("prototype", "nearest-centroid", "forest", "1nn-dtw", "1nn-dtw-velocity", "minirocket",
+        "shapelets", "forest-shapelets")  # fmt: skip
+
+
+def in_own_frames(demos: np.ndarray, space: str, seed: int) -> np.ndarray:
+    """Every demonstration ``demos[shape, demo]`` in a world frame of its own: ``+-g q``
+    for a random unit quaternion ``g`` and sign, or ``R X R^T`` for a random rotation."""
+    rng = np.random.default_rng(seed)
+    out = np.empty_like(demos)
+    for index in np.ndindex(*demos.shape[:2]):
+        if space == "quaternion":
+            g = Rotation.random(random_state=int(rng.integers(2**31))).as_quat()[[3, 0, 1, 2]]
+            out[index] = rng.choice([-1.0, 1.0]) * quaternion_product(g, demos[index])
+        else:
+            angle = rng.uniform(0, 2 * np.pi)
+            R = np.array([[np.cos(angle), -np.sin(angle)], [np.sin(angle), np.cos(angle)]])
+            out[index] = R @ demos[index] @ R.T
+    return out
 
 
 def load(space: str, root: Path, step: int) -> tuple[np.ndarray, np.ndarray]:
@@ -82,8 +112,13 @@ def run_fold(space, demos, shapes, fold, rows, method, seed, verbose) -> dict:
             start = time.perf_counter()
             predicted = model.predict(X_test)
             extra = {"decision": model.decision_} if row == "prototype" else {}
-        elif row == "forest":
-            model = RTWProximityForest(manifold=space, random_state=seed, n_jobs=1)
+        elif row in ("forest", "forest-shapelets", "shapelets"):
+            if row == "shapelets":
+                model = GeodesicShapeletClassifier(manifold=space, random_state=seed, n_jobs=1)
+            else:
+                splitters = [ElasticSplitter(), ShapeletSplitter()] if row != "forest" else None
+                model = RTWProximityForest(manifold=space, random_state=seed, n_jobs=1,
+                                           splitters=splitters)  # fmt: skip
             model.fit(X_train, y_train)
             fit = time.perf_counter() - start
             start = time.perf_counter()
@@ -131,6 +166,8 @@ def warm_up(rows) -> None:
         RTWNearestCentroid(method=method_object("rtw", n_epochs=2)).fit(X, y).predict(X)
     if "forest" in rows:
         RTWProximityForest(n_trees=2, random_state=0).fit(X, y).predict(X)
+    if "shapelets" in rows or "forest-shapelets" in rows:
+        GeodesicShapeletClassifier(n_shapelets=20, random_state=0).fit(X, y).predict(X)
 
 
 def markdown(results: dict, args: argparse.Namespace, command: str) -> str:
@@ -139,7 +176,8 @@ def markdown(results: dict, args: argparse.Namespace, command: str) -> str:
         "",
         f"Command: `{command}`  ",
         f"Machine: {machine()}; every {args.step}th sample (T = {1000 // args.step}), "
-        f"method {args.method}, seed {args.seed}.",
+        f"method {args.method}, seed {args.seed}"
+        + ("; every demonstration in its own world frame." if args.frames else "."),
         "",
         "| space | row | accuracy per fold | mean accuracy | fit s (all folds) | "
         "predict s (all folds) |",
@@ -170,6 +208,8 @@ def main(argv=None) -> int:
     parser.add_argument("--method", default="rtw", help="averaging method of the centroids")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--markdown", default=None, help="write the table to this file")
+    parser.add_argument("--frames", action="store_true",
+                        help="every demonstration in a world frame of its own")  # fmt: skip
     parser.add_argument("--quiet", action="store_true")
     args = parser.parse_args(argv)
     if args.step < 1:
@@ -181,6 +221,8 @@ def main(argv=None) -> int:
     results: dict = {}
     for space in args.spaces:
         demos, shapes = load(space, root, args.step)
+        if args.frames:
+            demos = in_own_frames(demos, space, args.seed)
         results[space] = {}
         for fold in args.folds:
             results[space][fold] = run_fold(

@@ -29,7 +29,7 @@ from .estimators import (
     TTWAverager,
     TTWNearestCentroid,
 )
-from .forest import ElasticSplitter, RTWProximityForest
+from .forest import ElasticSplitter, RTWProximityForest, ShapeletSplitter
 from .manifolds import (
     SPD,
     Euclidean,
@@ -72,6 +72,7 @@ __all__ = [
     "RTWNearestCentroid",
     "RTWPrototypeClassifier",
     "RTWProximityForest",
+    "ShapeletSplitter",
     "Sphere",
     "TTWAverager",
     "TTWNearestCentroid",

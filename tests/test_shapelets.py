@@ -12,8 +12,7 @@ from sklearn.model_selection import GridSearchCV
 from sklearn.utils.estimator_checks import parametrize_with_checks
 
 from sk_rtw import SPD, GeodesicShapeletClassifier, GeodesicShapeletTransform, Quaternion
-from sk_rtw.manifolds import Euclidean, Product, Sphere
-from sk_rtw.manifolds._sphere import quaternion_product
+from sk_rtw.manifolds import Euclidean, Product, Sphere, quaternion_product
 
 from .test_dtw import random_walk
 from .test_estimators import EXPECTED_FAILURES

@@ -63,9 +63,12 @@ from scipy.special import softmax
 from sk_rtw import (
     Alignment,
     AutoChoice,
+    ElasticSplitter,
+    GeodesicShapeletClassifier,
     RTWNearestCentroid,
     RTWPrototypeClassifier,
     RTWProximityForest,
+    ShapeletSplitter,
     dtw_nearest_distance,
     dtw_pairwise_distance,
 )
@@ -109,15 +112,19 @@ FOREST_METHODS: dict[str, dict] = {
     "rtw-forest": {},
     "rtw-forest-raw": {"representation": "raw"},
     "rtw-forest-mean": {"exemplars": "mean"},
+    # elastic and shapelet candidates at every node (5 of each)
+    "rtw-forest-shapelets": {"splitters": (ElasticSplitter(), ShapeletSplitter())},
 }
 #: Rows of the classifier a user gets by default.
 DEFAULT_CLASSIFIERS = tuple(m for m in ESTIMATOR_METHODS if m.endswith("-default"))
 #: Rows of RTWPrototypeClassifier.
 PROTOTYPE_CLASSIFIERS = tuple(m for m in ESTIMATOR_METHODS if m.endswith("-prototype"))
-REFERENCE_METHODS = ("aeon-dba", "1nn-dtw", "1nn-dtw-band", "minirocket")
+REFERENCE_METHODS = ("aeon-dba", "1nn-dtw", "1nn-dtw-band", "minirocket", "rdst")
+#: Rows of GeodesicShapeletClassifier (geodesic dilated shapelets, ridge readout).
+SHAPELET_METHODS = ("rtw-shapelets",)
 #: Rows that do not depend on the seed: ``--resume`` keeps them when only the seed changed.
 SEED_FREE = ("1nn-dtw", "1nn-dtw-band")
-ALL_METHODS = (*ESTIMATOR_METHODS, *FOREST_METHODS, *REFERENCE_METHODS)
+ALL_METHODS = (*ESTIMATOR_METHODS, *FOREST_METHODS, *SHAPELET_METHODS, *REFERENCE_METHODS)
 #: The main job's rows: the paper's one-mean comparison, the default classifier, the
 #: prototype classifier and the references (``rtw-paper`` is slow: means of length N T
 #: with the network at every time point; the ablations and the other default and
@@ -370,6 +377,44 @@ def _fit_minirocket(train, test, config):
     }
 
 
+def _fit_shapelets(train, test, config):
+    """GeodesicShapeletClassifier() on one thread."""
+    classifier = GeodesicShapeletClassifier(random_state=config.seed, n_jobs=1)
+    start = time.perf_counter()
+    classifier.fit(train.X, train.y)
+    fit_seconds = time.perf_counter() - start
+    start = time.perf_counter()
+    predictions = classifier.predict(test.X)
+    return {
+        "fit_seconds": fit_seconds,
+        "predict_seconds": time.perf_counter() - start,
+        "predictions": predictions,
+        "classes": classifier.classes_,
+        "parameters": repr(classifier),
+    }
+
+
+def _fit_rdst(train, test, config):
+    """aeon's RDSTClassifier (random dilated shapelets, ridge readout), one thread."""
+    try:
+        from aeon.classification.shapelet_based import RDSTClassifier
+    except ImportError as exc:  # pragma: no cover - the benchmark needs aeon for its data
+        raise ImportError("the rdst row needs aeon (pip install 'sk-rtw[benchmarks]')") from exc
+    classifier = RDSTClassifier(random_state=config.seed, n_jobs=1)
+    start = time.perf_counter()
+    classifier.fit(to_aeon(train.X), train.y)
+    fit_seconds = time.perf_counter() - start
+    start = time.perf_counter()
+    predictions = classifier.predict(to_aeon(test.X))
+    return {
+        "fit_seconds": fit_seconds,
+        "predict_seconds": time.perf_counter() - start,
+        "predictions": predictions,
+        "classes": classifier.classes_,
+        "parameters": repr(classifier),
+    }
+
+
 def _fit_1nn_band(train, test, config):
     """1-NN DTW (squared point costs) in the band with the best leave-one-out accuracy."""
     classes, codes = np.unique(train.y, return_inverse=True)
@@ -473,6 +518,11 @@ def warm_up(methods) -> None:
                 X, y
             ).predict(X)
             _WARM.add(method)
+        if method in ("rtw-shapelets", "rdst") and method not in _WARM:
+            split = Split(X=X, y=np.asarray(y), lengths=np.full(len(X), X.shape[1]))
+            fitter = _fit_shapelets if method == "rtw-shapelets" else _fit_rdst
+            fitter(split, split, RunConfig(verbose=0))
+            _WARM.add(method)
         if method == "minirocket" and method not in _WARM:  # numba compiles its kernels
             split = Split(X=X, y=np.asarray(y), lengths=np.full(len(X), X.shape[1]))
             _fit_minirocket(split, split, RunConfig(verbose=0))
@@ -566,6 +616,10 @@ def _process_dataset(name, config, position, on_method_done) -> dict:
                     out = _fit_1nn_band(train, test, config)
                 elif method == "minirocket":
                     out = _fit_minirocket(train, test, config)
+                elif method == "rtw-shapelets":
+                    out = _fit_shapelets(train, test, config)
+                elif method == "rdst":
+                    out = _fit_rdst(train, test, config)
                 else:
                     raise ValueError(f"unknown method {method!r}")
             except Exception as exc:  # one method failing must not lose the others

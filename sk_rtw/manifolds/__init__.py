@@ -7,7 +7,7 @@ from ._euclidean import Euclidean
 from ._product import Product
 from ._registry import ManifoldSpec, available_manifolds, get_manifold, register_manifold
 from ._spd import SPD
-from ._sphere import Quaternion, Sphere
+from ._sphere import Quaternion, Sphere, quaternion_conjugate, quaternion_product
 
 __all__ = [
     "SPD",
@@ -22,5 +22,7 @@ __all__ = [
     "check_manifold",
     "compiled_maps",
     "get_manifold",
+    "quaternion_conjugate",
+    "quaternion_product",
     "register_manifold",
 ]
