@@ -26,6 +26,7 @@ from .estimators import (
     RTWKMeans,
     RTWNearestCentroid,
     RTWPrototypeClassifier,
+    TangentVelocity,
     TTWAverager,
     TTWNearestCentroid,
 )
@@ -76,6 +77,7 @@ __all__ = [
     "Sphere",
     "TTWAverager",
     "TTWNearestCentroid",
+    "TangentVelocity",
     "__version__",
     "align",
     "aligned_statistics",

@@ -15,6 +15,7 @@ ask for a representation by name (:data:`REPRESENTATIONS`).
 
 from __future__ import annotations
 
+import warnings
 from typing import Any
 
 import numpy as np
@@ -24,6 +25,26 @@ from .utils import SeriesCollection, check_series_collection
 
 #: The representations a classifier can compare series in.
 REPRESENTATIONS = ("raw", "velocity")
+#: The values every ``representation`` parameter takes: one of :data:`REPRESENTATIONS`,
+#: or ``"auto"``, chosen from the training data (by a held-out choice in the centroid
+#: estimators, split by split in the forest, shapelet by shapelet in the shapelets).
+REPRESENTATION_VALUES = (*REPRESENTATIONS, "auto")
+#: The forest's former word for ``"auto"``, still accepted with a FutureWarning.
+DEPRECATED_BOTH = "both"
+
+
+def drawn_representations(value: str) -> tuple[str, ...]:
+    """The representations an estimator that draws them (the forest, the shapelets)
+    draws from for a ``representation`` value: every one for ``"auto"``."""
+    if value == DEPRECATED_BOTH:
+        warnings.warn(
+            'representation="both" is now representation="auto" (the same draw); "both" '
+            "will be removed",
+            FutureWarning,
+            stacklevel=3,
+        )
+        value = "auto"
+    return REPRESENTATIONS if value == "auto" else (value,)
 
 
 def velocity_collection(collection: SeriesCollection) -> SeriesCollection:

@@ -130,7 +130,7 @@ def test_every_candidate_sends_each_series_to_its_nearest_exemplar(manifold):
     training = TrainingSet.build(check_series_collection(X, manifold), ("raw", "velocity"),
                                  codes, 2)  # fmt: skip
     splitters = (ElasticSplitter().resolved(
-        {"n_candidates": 3, "representation": "both", "exemplars": "series"}),)  # fmt: skip
+        {"n_candidates": 3, "representation": "auto", "exemplars": "series"}),)  # fmt: skip
     indices = np.arange(2, 14)
     for seed in range(6):
         node = NodeSeries(training, indices, codes[indices])

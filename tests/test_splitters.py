@@ -46,7 +46,7 @@ def test_the_default_splitter_written_out_is_the_default_forest():
     test, _ = three_classes(seed=4)
     default = RTWProximityForest(n_trees=6, random_state=0).fit(X, y)
     written = ElasticSplitter(
-        n_candidates=5, representation="both", exemplars="series", exponents=(0.5, 1.0, 2.0),
+        n_candidates=5, representation="auto", exemplars="series", exponents=(0.5, 1.0, 2.0),
         measures=("dtw", "adtw"), max_window=0.25, penalty_steps=100, penalty_exponent=5,
         penalty_pairs=50, mean_subset=10, mean_iterations=5,
     )  # fmt: skip
@@ -225,7 +225,7 @@ def test_a_shapelet_split_routes_new_series_as_it_split_the_node():
     codes = np.searchsorted(np.unique(y), y)
     collection = check_series_collection(X)
     training = TrainingSet.build(collection, ("raw", "velocity"), codes, 3)
-    splitter = ShapeletSplitter().resolved({"n_candidates": 1, "representation": "both"})
+    splitter = ShapeletSplitter().resolved({"n_candidates": 1, "representation": "auto"})
     indices = np.arange(3, 24)
     for seed in range(8):
         node = NodeSeries(training, indices, codes[indices])
@@ -260,3 +260,15 @@ def test_shapelet_splits_find_a_local_pattern():
         RTWProximityForest(n_trees=1, splitters=[ShapeletSplitter(lengths=(99,))]).fit(X, y)
     with pytest.raises(ValueError, match="features"):
         RTWProximityForest(n_trees=1, splitters=[ShapeletSplitter(features=("max",))]).fit(X, y)
+
+
+def test_one_representation_vocabulary_and_both_deprecated():
+    """"auto" means chosen from the training data everywhere; the forest's former
+    "both" is the same draw, with a FutureWarning."""
+    X, y = three_classes(n_per_class=4)
+    auto = RTWProximityForest(n_trees=3, random_state=0).fit(X, y)
+    assert auto.get_params()["representation"] == "auto"
+    with pytest.warns(FutureWarning, match='representation="both" is now'):
+        both = RTWProximityForest(n_trees=3, representation="both", random_state=0).fit(X, y)
+    np.testing.assert_array_equal(both.predict_proba(X), auto.predict_proba(X))
+    assert both.representations_ == auto.representations_ == ("raw", "velocity")

@@ -76,7 +76,7 @@ class RTWProximityForestClassifier(DelegatingClassifier):
         n_trees: int = 100,
         splitters: tuple[Splitter, ...] | None = None,
         n_candidates: int = 5,
-        representation: str = "both",
+        representation: str = "auto",
         exemplars: str = "series",
         max_depth: int | None = None,
         n_jobs: int | None = 1,

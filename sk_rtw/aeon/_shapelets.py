@@ -72,7 +72,7 @@ class GeodesicShapeletClassifier(DelegatingClassifier):
         n_shapelets: int = 10_000,
         lengths: tuple[int, ...] | None = None,
         normalised_fraction: float = 0.5,
-        representation: str = "both",
+        representation: str = "auto",
         threshold_percentiles: tuple[float, float] = (5.0, 10.0),
         readout: Any = None,
         n_jobs: int | None = 1,

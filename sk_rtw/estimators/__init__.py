@@ -7,6 +7,7 @@ from ._classifier import NTWNearestCentroid, RTWNearestCentroid, TTWNearestCentr
 from ._kmeans import RTWKMeans
 from ._prototypes import RTWPrototypeClassifier
 from ._ridge_readout import RidgeGCVClassifier
+from ._velocity import TangentVelocity
 
 __all__ = [
     "AutoChoice",
@@ -19,4 +20,5 @@ __all__ = [
     "RidgeGCVClassifier",
     "TTWAverager",
     "TTWNearestCentroid",
+    "TangentVelocity",
 ]

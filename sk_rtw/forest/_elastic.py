@@ -41,7 +41,7 @@ import numpy as np
 
 from ..baselines import dba_average
 from ..dtw import EXPONENTS, PreparedSeries, mean_diagonal_cost, nearest_group, prepare_series
-from ..representations import REPRESENTATIONS
+from ..representations import DEPRECATED_BOTH, REPRESENTATION_VALUES, drawn_representations
 from ..utils import SeriesCollection, check_series_collection
 from ..utils._constraints import Constant, Interval, InvalidParameterError, Options, Satisfies
 from ..utils._params import Parameter, declare_parameters, validate_parameters
@@ -50,9 +50,9 @@ from ._splitter import Splitter
 
 #: The measures a candidate may draw: DTW in a band, amerced DTW without one.
 MEASURES = ("dtw", "adtw")
-#: Representation values: one of :data:`~sk_rtw.representations.REPRESENTATIONS`, or
-#: ``"both"`` (drawn for every candidate).
-REPRESENTATION_OPTIONS = ("both", *REPRESENTATIONS)
+#: Representation values: :data:`~sk_rtw.representations.REPRESENTATION_VALUES` (``"auto"``
+#: drawn for every candidate), and the deprecated ``"both"``, the same as ``"auto"``.
+REPRESENTATION_OPTIONS = (*REPRESENTATION_VALUES, DEPRECATED_BOTH)
 #: Exemplar kinds: a training series per class, or a DBA mean of a subset of it.
 EXEMPLAR_KINDS = ("series", "mean")
 
@@ -86,7 +86,7 @@ ELASTIC_PARAMETERS = (
         "representation",
         (Constant(None, "the forest's representation"), Options(REPRESENTATION_OPTIONS)),
         'What the measures compare: "raw" the series, "velocity" their tangent velocity, '
-        '"both" drawn for every candidate (None: the forest\'s ``representation``).',
+        '"auto" drawn for every candidate (None: the forest\'s ``representation``).',
     ),
     Parameter(
         "exemplars",
@@ -286,17 +286,18 @@ class ElasticSplitter(Splitter):
         for name in _INHERITED:
             if values[name] is None:
                 values[name] = defaults[name]
+        if values["representation"] == DEPRECATED_BOTH:
+            drawn_representations(DEPRECATED_BOTH)  # the warning
+            values["representation"] = "auto"
         values["exponents"] = tuple(float(e) for e in values["exponents"])
         values["measures"] = tuple(str(m).lower() for m in values["measures"])
         return ElasticSplitter(**values)
 
     @property
     def representations(self) -> tuple[str, ...]:
-        if self.representation == "both":
-            return REPRESENTATIONS
         if self.representation is None:
             raise RuntimeError("an unresolved splitter: call resolved() first")
-        return (self.representation,)
+        return drawn_representations(self.representation)
 
     def draw_measure(self, node: NodeSeries, rng: np.random.Generator) -> Measure:
         """One measure, drawn as the module docstring says."""

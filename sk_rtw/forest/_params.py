@@ -44,9 +44,10 @@ N_CANDIDATES = Parameter(
 REPRESENTATION = Parameter(
     "representation",
     (Options(REPRESENTATION_OPTIONS),),
-    'What the measures compare, for every splitter that does not set its own: "raw" the '
+    'What the splits compare, for every splitter that does not set its own: "raw" the '
     'series, "velocity" their tangent velocity (sk_rtw.tangent_velocity: the derivative '
-    'series of the manifold), "both" drawn for every candidate split.',
+    'series of the manifold), "auto" chosen split by split (drawn for every candidate, '
+    'the Gini gain keeps one). "both", its former name, is deprecated.',
 )
 EXEMPLARS = Parameter(
     "exemplars",

@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from ..representations import REPRESENTATIONS
+from ..representations import DEPRECATED_BOTH, drawn_representations
 from ..shapelets import (
     FEATURES,
     Shapelet,
@@ -77,7 +77,7 @@ SHAPELET_SPLITTER_PARAMETERS = (
     Parameter(
         "representation",
         (Constant(None, "the forest's representation"), Options(REPRESENTATION_OPTIONS)),
-        'Where shapelets are drawn: "raw", "velocity", "both" (None: the forest\'s).',
+        'Where shapelets are drawn: "raw", "velocity", "auto" either (None: the forest\'s).',
     ),
     Parameter(
         "lengths",
@@ -247,6 +247,9 @@ class ShapeletSplitter(Splitter):
         for name in ("n_candidates", "representation"):
             if values[name] is None:
                 values[name] = defaults[name]
+        if values["representation"] == DEPRECATED_BOTH:
+            drawn_representations(DEPRECATED_BOTH)  # the warning
+            values["representation"] = "auto"
         if values["lengths"] is not None:
             values["lengths"] = tuple(int(v) for v in values["lengths"])
         values["threshold_percentiles"] = tuple(float(v) for v in values["threshold_percentiles"])
@@ -255,11 +258,9 @@ class ShapeletSplitter(Splitter):
 
     @property
     def representations(self) -> tuple[str, ...]:
-        if self.representation == "both":
-            return REPRESENTATIONS
         if self.representation is None:
             raise RuntimeError("an unresolved splitter: call resolved() first")
-        return (self.representation,)
+        return drawn_representations(self.representation)
 
     def _lengths(self, node: NodeSeries) -> tuple[int, ...]:
         shortest = min(int(node.training.collections[r].lengths.min())

@@ -13,7 +13,12 @@ from sklearn.utils.validation import check_is_fitted
 
 from .._random import check_generator
 from .._threads import limited_threads, resolve_n_jobs, thread_map
-from ..representations import REPRESENTATIONS, represent
+from ..representations import (
+    DEPRECATED_BOTH,
+    REPRESENTATION_VALUES,
+    drawn_representations,
+    represent,
+)
 from ..utils import check_labels, check_series_collection, encode_labels
 from ..utils._common_params import MANIFOLD, N_JOBS, RANDOM_STATE, VERBOSE
 from ..utils._constraints import Constant, Interval, Options, Satisfies
@@ -77,9 +82,10 @@ SHAPELET_PARAMETERS = (
     ),
     Parameter(
         "representation",
-        (Options(("both", *REPRESENTATIONS)),),
+        (Options((*REPRESENTATION_VALUES, DEPRECATED_BOTH)),),
         'Where shapelets are drawn: "raw" the series, "velocity" their tangent velocity, '
-        '"both" either, uniformly.',
+        '"auto" either, shapelet by shapelet (uniformly; the readout weighs them). "both", '
+        "the forest's former word for it, is deprecated.",
     ),
     Parameter(
         "threshold_percentiles",
@@ -97,7 +103,7 @@ SHAPELET_DEFAULTS = {
     "n_shapelets": 10_000,
     "lengths": None,
     "normalised_fraction": 0.5,
-    "representation": "both",
+    "representation": "auto",
     "threshold_percentiles": (5.0, 10.0),
     "n_jobs": None,
     "random_state": None,
@@ -107,7 +113,7 @@ SHAPELET_DEFAULTS = {
 
 def representations_of(value: str) -> tuple[str, ...]:
     """The representations a ``representation`` value draws from."""
-    return REPRESENTATIONS if value == "both" else (value,)
+    return drawn_representations(value)
 
 
 def default_length(shortest: int) -> int:
@@ -188,7 +194,7 @@ class GeodesicShapeletTransform(TransformerMixin, BaseEstimator):
         n_shapelets: int = 10_000,
         lengths: tuple[int, ...] | None = None,
         normalised_fraction: float = 0.5,
-        representation: str = "both",
+        representation: str = "auto",
         threshold_percentiles: tuple[float, float] = (5.0, 10.0),
         n_jobs: int | None = None,
         random_state: int | np.random.RandomState | np.random.Generator | None = None,
