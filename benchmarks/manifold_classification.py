@@ -16,6 +16,8 @@ demonstration ``k`` of every shape and trains on the other three (4 folds, 30 cl
   Euclidean point cost, no band);
 * ``minirocket``: aeon's ``MiniRocketClassifier`` on the coordinates (the 4 quaternion
   components; the 3 distinct entries of a 2 x 2 SPD matrix), which knows no manifold;
+* ``minirocket-velocity``: MiniRocket on the tangent velocity
+  (``make_pipeline(TangentVelocity(space, output="aeon"), MiniRocketClassifier())``);
 * ``shapelets``: ``GeodesicShapeletClassifier(manifold=...)``, the library's defaults;
 * ``forest-shapelets``: the forest with elastic and shapelet candidates
   (``splitters=[ElasticSplitter(), ShapeletSplitter()]``).
@@ -41,6 +43,7 @@ from pathlib import Path
 
 import numpy as np
 from scipy.spatial.transform import Rotation
+from sklearn.pipeline import make_pipeline
 
 if __package__ in (None, ""):
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
@@ -54,6 +57,7 @@ from sk_rtw import (
     RTWPrototypeClassifier,
     RTWProximityForest,
     ShapeletSplitter,
+    TangentVelocity,
     dtw_pairwise_distance,
     tangent_velocity,
 )
@@ -61,7 +65,7 @@ from sk_rtw.manifolds import quaternion_product
 
 SPACES = ("quaternion", "spd")
 ROWS = ("prototype", "nearest-centroid", "forest", "1nn-dtw", "1nn-dtw-velocity", "minirocket",
-        "shapelets", "forest-shapelets")  # fmt: skip
+        "minirocket-velocity", "shapelets", "forest-shapelets")  # fmt: skip
 
 
 def in_own_frames(demos: np.ndarray, space: str, seed: int) -> np.ndarray:
@@ -132,6 +136,15 @@ def run_fold(space, demos, shapes, fold, rows, method, seed, verbose) -> dict:
             D = dtw_pairwise_distance(tangent_velocity(X_test, space),
                                       tangent_velocity(X_train, space))  # fmt: skip
             predicted, extra = y_train[D.argmin(1)], {}
+        elif row == "minirocket-velocity":
+            from aeon.classification.convolution_based import MiniRocketClassifier
+
+            model = make_pipeline(TangentVelocity(space, output="aeon"),
+                                  MiniRocketClassifier(random_state=seed, n_jobs=1))  # fmt: skip
+            model.fit(X_train, y_train)
+            fit = time.perf_counter() - start
+            start = time.perf_counter()
+            predicted, extra = model.predict(X_test), {}
         else:
             from aeon.classification.convolution_based import MiniRocketClassifier
 
@@ -157,7 +170,7 @@ def warm_up(rows) -> None:
     multivariate kernels)."""
     rng = np.random.default_rng(0)
     X, y = rng.standard_normal((8, 20)).cumsum(1), np.repeat([0, 1], 4)
-    if "minirocket" in rows:
+    if "minirocket" in rows or "minirocket-velocity" in rows:
         from aeon.classification.convolution_based import MiniRocketClassifier
 
         for channels in (X[:, None], np.stack([X, X[::-1], -X], axis=1)):
