@@ -272,3 +272,18 @@ def test_one_representation_vocabulary_and_both_deprecated():
         both = RTWProximityForest(n_trees=3, representation="both", random_state=0).fit(X, y)
     np.testing.assert_array_equal(both.predict_proba(X), auto.predict_proba(X))
     assert both.representations_ == auto.representations_ == ("raw", "velocity")
+
+
+def test_shapelet_splits_route_series_shorter_than_their_span():
+    """GesturePebbleZ1's test set holds series shorter than any training series: a
+    shapelet split reads them as padded with their last point."""
+    from sk_rtw.forest import ShapeletSplitter
+
+    rng = np.random.default_rng(0)
+    X = [rng.standard_normal(int(n)) + (i % 2) * 2 for i, n in enumerate(rng.integers(40, 60, 12))]
+    y = np.arange(12) % 2
+    forest = RTWProximityForest(n_trees=4, random_state=0,
+                                splitters=[ShapeletSplitter(representation="raw")]).fit(X, y)  # fmt: skip
+    short = [x[:5] for x in X]
+    proba = forest.predict_proba(short)
+    assert proba.shape == (12, 2) and np.allclose(proba.sum(1), 1.0)

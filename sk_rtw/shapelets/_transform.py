@@ -275,8 +275,9 @@ class GeodesicShapeletTransform(TransformerMixin, BaseEstimator):
         Parameters
         ----------
         X : array-like of shape (n_series, n_timepoints[, *point_shape]) or list
-            Series on the training manifold, each at least as long as the longest
-            shapelet's span.
+            Series on the training manifold (at least 2 samples where the velocity is
+            read). A series shorter than a shapelet's span is read as padded with its
+            last point: one window.
 
         Returns
         -------
@@ -297,15 +298,8 @@ class GeodesicShapeletTransform(TransformerMixin, BaseEstimator):
         return np.concatenate(parts, axis=0).reshape(n, -1) if parts else np.empty((0, 0))
 
     def _collections(self, X: Any) -> dict:
-        needed = max(s.span + (s.representation == "velocity") for s in self.shapelets_)
-        collection = check_series_collection(X, self.manifold_, min_length=1)
-        if collection.lengths.min() < needed:
-            short = int(np.argmin(collection.lengths))
-            raise ValueError(
-                f"series {short} has {collection.lengths[short]} time points; the "
-                f"shapelets span up to {needed} (their length times their dilation, from "
-                "the shortest training series): pad or drop shorter series"
-            )
+        shortest = 2 if "velocity" in self.representations_ else 1
+        collection = check_series_collection(X, self.manifold_, min_length=shortest)
         return {r: represent(collection, r) for r in self.representations_}
 
     def get_feature_names_out(self, input_features: Any = None) -> np.ndarray:

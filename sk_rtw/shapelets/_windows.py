@@ -42,15 +42,10 @@ def gather_windows(
     """The windows ``(x_t, x_{t+d}, ..., x_{t+(l-1)d})`` of every series of
     ``collection``, normalised by the manifold (:meth:`~sk_rtw.manifolds.Manifold.
     normalise_windows`) if ``normalised``, in the kernels' form of their space. A series
-    of ``T`` points has ``T - (l - 1) d`` windows (at least one is required)."""
+    of ``T`` points has ``T - (l - 1) d`` windows; one shorter than a window's span is
+    read as padded with its last point (the package's padding convention): one window."""
     span = (length - 1) * dilation
-    counts = collection.lengths - span
-    if (counts < 1).any():
-        short = int(np.argmin(counts))
-        raise ValueError(
-            f"series {short} has {collection.lengths[short]} time points: a shapelet of "
-            f"{length} points at dilation {dilation} spans {span + 1}"
-        )
+    counts = np.maximum(collection.lengths - span, 1)
     n_windows = int(counts.max())
     starts = np.arange(n_windows)
     offsets = starts[:, None] + dilation * np.arange(length)[None, :]
