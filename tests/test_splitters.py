@@ -282,8 +282,8 @@ def test_shapelet_splits_route_series_shorter_than_their_span():
     rng = np.random.default_rng(0)
     X = [rng.standard_normal(int(n)) + (i % 2) * 2 for i, n in enumerate(rng.integers(40, 60, 12))]
     y = np.arange(12) % 2
-    forest = RTWProximityForest(n_trees=4, random_state=0,
-                                splitters=[ShapeletSplitter(representation="raw")]).fit(X, y)  # fmt: skip
+    raw = [ShapeletSplitter(representation="raw")]
+    forest = RTWProximityForest(n_trees=4, random_state=0, splitters=raw).fit(X, y)
     short = [x[:5] for x in X]
     proba = forest.predict_proba(short)
     assert proba.shape == (12, 2) and np.allclose(proba.sum(1), 1.0)

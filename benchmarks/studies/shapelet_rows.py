@@ -30,7 +30,7 @@ def published(path: Path) -> dict[str, dict[str, float]]:
     with open(path, newline="") as handle:
         return {
             row["dataset"]: {k: float(row[f"{k}_split0"]) for k in PUBLISHED
-                             if row.get(f"{k}_split0")}  # fmt: skip
+                             if row.get(f"{k}_split0")}
             for row in csv.DictReader(handle)
         }
 
@@ -49,7 +49,8 @@ def summary(folder: Path, table: dict) -> str:
         lines.append(f"  {row:22s} covered {acc:.4f}  all {acc_all:.4f}  fit {fit:8.1f} s  "
                      f"predict {predict:7.1f} s")  # fmt: skip
     for name in PUBLISHED:
-        lines.append(f"  {name:22s} covered {np.mean([table[r['dataset']][name] for r in covered]):.4f}")
+        mean = np.mean([table[r["dataset"]][name] for r in covered])
+        lines.append(f"  {name:22s} covered {mean:.4f}")
     if {"rtw-forest", "rtw-forest-shapelets"} <= set(rows):
         ratio = [sum(rec["methods"][r][k] for rec in records)
                  for r in ("rtw-forest-shapelets", "rtw-forest")
