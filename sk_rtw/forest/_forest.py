@@ -6,11 +6,12 @@ import sys
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from joblib import Parallel, delayed
 from sklearn.base import BaseEstimator, ClassifierMixin
 from sklearn.utils.validation import check_is_fitted
 
 from .._random import check_generator
-from .._threads import limited_threads, resolve_n_jobs, thread_map
+from .._threads import limited_threads, resolve_n_jobs
 from ..utils import check_classes, check_series_collection
 from ..utils._common_params import MANIFOLD, N_JOBS, RANDOM_STATE, VERBOSE
 from ..utils._constraints import Interval
@@ -217,8 +218,13 @@ class RTWProximityForest(ClassifierMixin, BaseEstimator):
                 )  # fmt: skip
             return tree
 
+        # trees through joblib, preferring threads (the kernels release the GIL): a user's
+        # joblib.parallel_config decides where they run (a dask cluster's workers
+        # included); every seed was drawn above, so the forest is the same anywhere
         with limited_threads(1):  # one thread per tree, each tree on one core
-            self.trees_ = thread_map(grow, range(total), resolve_n_jobs(params["n_jobs"]))
+            self.trees_ = Parallel(n_jobs=params["n_jobs"], prefer="threads")(
+                delayed(grow)(position) for position in range(total)
+            )
         self.classes_ = classes
         self.manifold_ = manifold
         self.splitters_ = splitters
@@ -244,9 +250,10 @@ class RTWProximityForest(ClassifierMixin, BaseEstimator):
         check_is_fitted(self, "trees_")
         data = prepare_representations(X, self.manifold_, self.representations_, self.scale_)
         n = data.n_series
-        with limited_threads(1):
-            votes = thread_map(lambda tree: tree._proba(data, n), self.trees_,
-                               resolve_n_jobs(self.n_jobs))  # fmt: skip
+        with limited_threads(1):  # the test series are shared: threads, as scikit-learn
+            votes = Parallel(n_jobs=resolve_n_jobs(self.n_jobs), require="sharedmem")(
+                delayed(tree._proba)(data, n) for tree in self.trees_
+            )
         total = np.zeros((n, len(self.classes_)))
         for vote in votes:  # in the trees' order: the same sum for any n_jobs
             total += vote
