@@ -45,7 +45,7 @@ from ..representations import DEPRECATED_BOTH, REPRESENTATION_VALUES, drawn_repr
 from ..utils import SeriesCollection, check_series_collection
 from ..utils._constraints import Constant, Interval, InvalidParameterError, Options, Satisfies
 from ..utils._params import Parameter, declare_parameters, validate_parameters
-from ._series import NodeSeries
+from ._series import ExemplarStore, NodeSeries
 from ._splitter import Splitter
 
 #: The measures a candidate may draw: DTW in a band, amerced DTW without one.
@@ -194,21 +194,33 @@ class NearestExemplarSplit:
     measure : Measure
     classes : ndarray of int
         The class of each branch (codes into the forest's ``classes_``).
-    exemplars : PreparedSeries
-        Each branch's exemplar, in the measure's representation, prepared for the search.
     sources : ndarray of int
-        Where each exemplar was drawn from, for reading: the index of a training series,
-        or -1 for a mean. Routing never reads it.
+        Where each exemplar was drawn from: the index of a training series, or -1 for a
+        mean.
+    means : PreparedSeries or None
+        The exemplars when they are means (held by the split itself).
+    store : ExemplarStore or None
+        Where training series exemplars are kept (once per forest).
     """
 
     measure: Measure
     classes: np.ndarray
-    exemplars: PreparedSeries
     sources: np.ndarray
+    means: PreparedSeries | None = None
+    store: ExemplarStore | None = None
 
     @property
     def n_branches(self) -> int:
         return len(self.classes)
+
+    @property
+    def exemplars(self) -> PreparedSeries:
+        """Each branch's exemplar, in the measure's representation, prepared for the
+        search."""
+        if self.means is not None:
+            return self.means
+        assert self.store is not None
+        return self.store.take(self.sources)
 
     def route(self, series: Mapping[str, PreparedSeries]) -> np.ndarray:
         """The branch of the nearest exemplar of every series (ties to the lowest)."""
@@ -332,13 +344,14 @@ class ElasticSplitter(Splitter):
         present, members = node.present, node.members
         measure = self.draw_measure(node, rng)
         if self.exemplars == "mean":
-            sources, exemplars = self._mean_exemplars(
+            sources, means = self._mean_exemplars(
                 rng, members, node.training.collections[measure.representation], measure
             )
-        else:
-            sources = np.array([rng.choice(m) for m in members], dtype=np.int64)
-            exemplars = node.training.prepared[measure.representation].take(sources)
-        return NearestExemplarSplit(measure, present, exemplars, sources)
+            return NearestExemplarSplit(measure, present, sources, means=means)
+        sources = np.array([rng.choice(m) for m in members], dtype=np.int64)
+        store = node.stores[measure.representation]
+        store.keep(sources)
+        return NearestExemplarSplit(measure, present, sources, store=store)
 
     def _mean_exemplars(
         self,

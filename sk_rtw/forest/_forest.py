@@ -57,6 +57,17 @@ FOREST_DEFAULTS = {
 }
 
 
+def share_exemplars(trees: list[ProximityTree], training: TrainingSet) -> None:
+    """One array of the training series any tree holds as an exemplar, per
+    representation, read by every tree's store (grown in this process or elsewhere)."""
+    for representation, prepared in training.prepared.items():
+        stores = [tree._stores[representation] for tree in trees]
+        rows = np.unique(np.concatenate([s.used for s in stores])).astype(np.int64)
+        shared = prepared.take(rows)
+        for store in stores:
+            store.rebase(shared, rows)
+
+
 @declare_parameters(FOREST_PARAMETERS, FOREST_DEFAULTS)
 class RTWProximityForest(ClassifierMixin, BaseEstimator):
     """Proximity Forest on any manifold: trees that split by the nearest exemplar under
@@ -225,6 +236,7 @@ class RTWProximityForest(ClassifierMixin, BaseEstimator):
             self.trees_ = Parallel(n_jobs=params["n_jobs"], prefer="threads")(
                 delayed(grow)(position) for position in range(total)
             )
+        share_exemplars(self.trees_, training)
         self.classes_ = classes
         self.manifold_ = manifold
         self.splitters_ = splitters

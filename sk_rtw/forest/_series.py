@@ -40,6 +40,53 @@ class SeriesSet:
         return next(iter(self.prepared.values())).n_series
 
 
+class ExemplarStore:
+    r"""The training series a tree's splits hold as exemplars, each kept once.
+
+    While the tree grows, :meth:`keep` hands out training series (read from the whole
+    training set, prepared); :meth:`compact` then keeps only those, and a forest
+    :meth:`rebase`\ s the stores of all its trees onto one shared array of the series
+    any of them kept: the fitted forest holds every exemplar once, not the training set.
+    """
+
+    def __init__(self, prepared: PreparedSeries) -> None:
+        self._full: PreparedSeries | None = prepared
+        self._used: set[int] = set()
+        self._data: PreparedSeries | None = None
+        self._rows = np.empty(0, dtype=np.int64)
+
+    def keep(self, rows: np.ndarray) -> None:
+        """Mark training series ``rows`` as held by a split."""
+        self._used.update(int(r) for r in rows)
+
+    @property
+    def used(self) -> np.ndarray:
+        """The training series held, ascending."""
+        return np.array(sorted(self._used), dtype=np.int64)
+
+    def take(self, rows: np.ndarray) -> PreparedSeries:
+        """Training series ``rows`` (each kept), prepared for the search."""
+        if self._data is None:
+            assert self._full is not None
+            return self._full.take(rows)
+        return self._data.take(np.searchsorted(self._rows, rows))
+
+    def compact(self) -> None:
+        """Keep only the series handed out."""
+        if self._full is not None:
+            rows = self.used
+            self.rebase(self._full.take(rows), rows)
+
+    def rebase(self, data: PreparedSeries, rows: np.ndarray) -> None:
+        """Read from ``data``, the training series ``rows`` (ascending; a superset of the
+        ones kept here), from now on."""
+        self._data, self._rows, self._full = data, rows, None
+
+    def __getstate__(self) -> dict:
+        self.compact()  # never the whole training set in a pickle
+        return self.__dict__.copy()
+
+
 @dataclass(frozen=True, eq=False)
 class TrainingSet(SeriesSet):
     """The training series (a :class:`SeriesSet`) with their class codes."""
@@ -54,6 +101,10 @@ class TrainingSet(SeriesSet):
     ) -> TrainingSet:  # fmt: skip
         collections, prepared = cls.represented(collection, representations)
         return cls(collections, prepared, np.asarray(codes), int(n_classes))
+
+    def exemplar_stores(self) -> dict[str, ExemplarStore]:
+        """Empty exemplar stores, one per representation (a tree's own)."""
+        return {r: ExemplarStore(p) for r, p in self.prepared.items()}
 
 
 def unit_frame(collection: SeriesCollection, scale: float | None = None) -> tuple[
@@ -112,7 +163,8 @@ class SeriesView(Mapping[str, PreparedSeries]):
 @dataclass(eq=False)
 class NodeSeries:
     """What a node's candidates share: the training set, the node's training
-    ``indices`` and class ``codes``, its series per representation (:attr:`series`,
+    ``indices`` and class ``codes``, the tree's exemplar stores (``stores``: where a
+    split keeps training series it holds), its series per representation (:attr:`series`,
     taken as candidates read them) and a memo where a splitter keeps what every one of
     its candidates at this node would compute again (drawn with the node's generator,
     so at the first candidate that needs it)."""
@@ -120,11 +172,14 @@ class NodeSeries:
     training: TrainingSet
     indices: np.ndarray
     codes: np.ndarray
+    stores: dict[str, ExemplarStore] = field(default_factory=dict)
     series: SeriesView = field(init=False)
     memo: dict[Any, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         self.series = SeriesView(self.training, self.indices)
+        if not self.stores:  # a node alone: stores of its own
+            self.stores = self.training.exemplar_stores()
 
     @property
     def n_classes(self) -> int:

@@ -216,6 +216,7 @@ class ProximityTree(ClassifierMixin, BaseEstimator):
         all its trees, divided by ``scale``), with checked, resolved splitters."""
         start = time.perf_counter()
         codes, n_classes = training.codes, training.n_classes
+        stores = training.exemplar_stores()
         counts = np.bincount(codes, minlength=n_classes)
         root = ProximityNode(counts / counts.sum(), len(codes), 0)
         stack = [(root, np.arange(len(codes)))]
@@ -228,7 +229,7 @@ class ProximityTree(ClassifierMixin, BaseEstimator):
                 n_leaves += 1
                 continue
             split, gain, branches = best_split(
-                NodeSeries(training, indices, codes[indices]), splitters, rng
+                NodeSeries(training, indices, codes[indices], stores), splitters, rng
             )
             sizes = np.bincount(branches, minlength=split.n_branches)
             if np.count_nonzero(sizes) < 2:  # no candidate told these series apart
@@ -246,6 +247,9 @@ class ProximityTree(ClassifierMixin, BaseEstimator):
                     n_leaves += 1
                 node.children.append(child)
                 n_nodes += 1
+        for store in stores.values():
+            store.compact()  # the exemplars its splits hold, not the training set
+        self._stores = stores
         self.root_ = root
         self.n_nodes_, self.n_leaves_, self.depth_ = n_nodes, n_leaves, depth
         self.classes_ = classes
