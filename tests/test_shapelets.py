@@ -214,3 +214,31 @@ def test_a_sphere_without_normalisation_draws_raw_shapelets_only():
     transform = GeodesicShapeletTransform("sphere", n_shapelets=20, normalised_fraction=1.0,
                                           representation="raw", random_state=0).fit(S)  # fmt: skip
     assert not any(s.normalised for s in transform.shapelets_)
+
+
+@pytest.mark.parametrize("space", ["quaternion", "spd"])
+def test_rlasa_demonstrations_in_their_own_frames_classify_the_same(space):
+    """R-LASA handwriting (8 shapes, leave demonstration 0 out), every demonstration in
+    a world frame of its own (a rotation and sign per quaternion series, a congruence
+    by a rotation per SPD series): the normalised shapelets' classifier predicts the
+    same classes, and fitted on the moved demonstrations it is the same classifier."""
+    from benchmarks.manifold_classification import in_own_frames, load
+    from benchmarks.paper._data import data_dir
+
+    try:
+        root = data_dir(None)
+    except FileNotFoundError:
+        pytest.skip("no shared demonstration data")
+    demos, shapes = load(space, root, 25)
+    demos, shapes = demos[::4], shapes[::4]
+    moved = in_own_frames(demos, space, 0)
+    X_train = demos[:, 1:].reshape(-1, *demos.shape[2:])
+    y_train = np.repeat(shapes, 3)
+    clf = GeodesicShapeletClassifier(space, n_shapelets=300, normalised_fraction=1.0,
+                                     representation="raw", random_state=0)  # fmt: skip
+    clf.fit(X_train, y_train)
+    assert clf.score(demos[:, 0], shapes) >= 0.75
+    np.testing.assert_array_equal(clf.predict(moved[:, 0]), clf.predict(demos[:, 0]))
+    refit = clone(clf).fit(moved[:, 1:].reshape(-1, *demos.shape[2:]), y_train)
+    np.testing.assert_allclose(refit.decision_function(moved[:, 0]),
+                               clf.decision_function(demos[:, 0]), atol=1e-6)  # fmt: skip
