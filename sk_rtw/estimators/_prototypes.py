@@ -8,14 +8,15 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from scipy.special import softmax
-from sklearn.base import BaseEstimator, ClassifierMixin, TransformerMixin, clone, is_classifier
+from sklearn.base import BaseEstimator, ClassifierMixin, TransformerMixin, clone
 from sklearn.pipeline import Pipeline, make_pipeline
 from sklearn.preprocessing import StandardScaler
 from sklearn.utils.metaestimators import available_if
 from sklearn.utils.validation import check_is_fitted
 
 from .._random import check_random_state
-from ..utils._constraints import Constant, Interval, Options, Satisfies
+from ..utils._common_params import CLASSIFIER
+from ..utils._constraints import Constant, Interval, Options
 from ..utils._params import Parameter, declare_parameters, validate_parameters
 from ._choice import DEFAULT_CHOICE, mcnemar
 from ._classifier import RTWNearestCentroid, fit_temperature
@@ -38,23 +39,11 @@ if TYPE_CHECKING:
     from ._choice import AutoChoice
 
 
-def _is_classifier(value: Any) -> bool:
-    """A scikit-learn classifier: fit, predict and the classifier tag."""
-    if not (hasattr(value, "fit") and hasattr(value, "predict")):
-        return False
-    try:
-        return bool(is_classifier(value))
-    except AttributeError:  # no scikit-learn tags
-        return False
-
-
 READOUT = Parameter(
     "readout",
     (
         Constant(None, "the default readout"),
-        Satisfies(
-            "classifier", "a scikit-learn classifier (fit, predict)", predicate=_is_classifier
-        ),
+        CLASSIFIER,
     ),
     "Classifier fitted on the features log(1 + d / s) of the out-of-fold distances d to "
     "every centroid (s: their median, ``distance_scale_``); cloned in fit. None: "

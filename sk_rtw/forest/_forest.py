@@ -12,7 +12,6 @@ from sklearn.utils.validation import check_is_fitted
 
 from .._random import check_generator
 from .._threads import limited_threads, resolve_n_jobs
-from ..utils import check_classes, check_series_collection
 from ..utils._common_params import MANIFOLD, N_JOBS, RANDOM_STATE, VERBOSE
 from ..utils._constraints import Interval
 from ..utils._params import Parameter, declare_parameters, validate_parameters
@@ -23,11 +22,10 @@ from ._params import (
     REPRESENTATION,
     SPLITTERS,
     representations_read,
-    resolve_splitters,
 )
-from ._series import TrainingSet, unit_frame
+from ._series import TrainingSet
 from ._splitter import Splitter
-from ._tree import ProximityTree, prepare_representations
+from ._tree import ProximityTree, prepare_representations, training_data
 
 if TYPE_CHECKING:
     from ..manifolds import Manifold
@@ -201,20 +199,17 @@ class RTWProximityForest(ClassifierMixin, BaseEstimator):
         self
         """
         params = validate_parameters(self)
-        splitters = resolve_splitters(params)
-        representations = representations_read(splitters)
-        shortest = 2 if "velocity" in representations else 1
-        collection = check_series_collection(X, self.manifold, min_length=shortest)
-        classes, codes = check_classes(type(self).__name__, y, collection.n_series)
+        data = training_data(type(self).__name__, X, y, params)
         rng = check_generator(self.random_state)
         seeds = rng.integers(np.iinfo(np.int64).max, size=params["n_trees"])  # before any work
-        unit, scale = unit_frame(collection)
-        training = TrainingSet.build(unit, representations, codes, len(classes))
+        splitters, training, classes, manifold = (
+            data.splitters, data.training, data.classes, data.manifold
+        )
         tree_params = {name: params[name] for name in ProximityTree._declaration.names
                        if name not in ("manifold", "random_state")}  # fmt: skip
         trees = [ProximityTree(self.manifold, **tree_params, random_state=int(seed))
                  for seed in seeds]  # fmt: skip
-        verbose, total, manifold = int(params["verbose"]), len(trees), collection.manifold
+        verbose, total, scale = int(params["verbose"]), len(trees), data.scale
 
         def grow(position: int) -> ProximityTree:
             tree = trees[position]._grow(
@@ -240,10 +235,10 @@ class RTWProximityForest(ClassifierMixin, BaseEstimator):
         self.classes_ = classes
         self.manifold_ = manifold
         self.splitters_ = splitters
-        self.representations_ = representations
+        self.representations_ = representations_read(splitters)
         self.scale_ = scale
-        if collection.equal_length and collection.manifold.point_shape == (1,):
-            self.n_features_in_ = collection.max_length
+        if data.n_features is not None:
+            self.n_features_in_ = data.n_features
         return self
 
     def predict_proba(self, X: Any) -> np.ndarray:

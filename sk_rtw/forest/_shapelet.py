@@ -16,7 +16,6 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from numbers import Integral, Real
 from typing import Any
 
 import numpy as np
@@ -24,6 +23,9 @@ import numpy as np
 from ..representations import DEPRECATED_BOTH, drawn_representations
 from ..shapelets import (
     FEATURES,
+    LENGTHS,
+    NORMALISED_FRACTION,
+    THRESHOLD_PERCENTILES,
     Shapelet,
     ShapeletBank,
     default_length,
@@ -36,27 +38,6 @@ from ..utils._params import Parameter, declare_parameters, validate_parameters
 from ._elastic import REPRESENTATION_OPTIONS
 from ._series import NodeSeries, SeriesView
 from ._splitter import Splitter
-
-
-def _is_lengths(value: Any) -> bool:
-    if isinstance(value, (str, bytes)) or not hasattr(value, "__iter__"):
-        return False
-    values = tuple(value)
-    return bool(values) and all(
-        isinstance(v, Integral) and not isinstance(v, (bool, np.bool_)) and int(v) >= 1
-        for v in values
-    )
-
-
-def _is_percentiles(value: Any) -> bool:
-    if isinstance(value, (str, bytes)) or not hasattr(value, "__iter__"):
-        return False
-    values = tuple(value)
-    return (
-        len(values) == 2
-        and all(isinstance(v, Real) and not isinstance(v, (bool, np.bool_)) for v in values)
-        and 0.0 <= values[0] <= values[1] <= 100.0
-    )
 
 
 def _is_features(value: Any) -> bool:
@@ -79,33 +60,16 @@ SHAPELET_SPLITTER_PARAMETERS = (
         (Constant(None, "the forest's representation"), Options(REPRESENTATION_OPTIONS)),
         'Where shapelets are drawn: "raw", "velocity", "auto" either (None: the forest\'s).',
     ),
-    Parameter(
-        "lengths",
-        (
-            Constant(None, "min(max(2, T // 2), 11) of the shortest training series"),
-            Satisfies(
-                "sequence of int",
-                "a non-empty sequence of integers >= 1",
-                predicate=_is_lengths,
-            ),
-        ),
-        "Points of a shapelet, drawn uniformly from these.",
-    ),
+    LENGTHS,
     Parameter(
         "normalised_fraction",
-        (Interval(float, 0.0, 1.0),),
+        NORMALISED_FRACTION.constraints,
         "Probability that a shapelet compares shape without position (the manifold's "
         "z-normalisation).",
     ),
     Parameter(
         "threshold_percentiles",
-        (
-            Satisfies(
-                "(float, float)",
-                "two percentiles 0 <= low <= high <= 100",
-                predicate=_is_percentiles,
-            ),
-        ),
+        THRESHOLD_PERCENTILES.constraints,
         "A shapelet's occurrence threshold between these percentiles of its distances to "
         "another series of its class at the node.",
     ),

@@ -15,6 +15,7 @@ which kind a split is.
 from __future__ import annotations
 
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -190,17 +191,11 @@ class ProximityTree(ClassifierMixin, BaseEstimator):
         self
         """
         params = validate_parameters(self)
-        splitters = resolve_splitters(params)
-        representations = representations_read(splitters)
-        shortest = 2 if "velocity" in representations else 1
-        collection = check_series_collection(X, self.manifold, min_length=shortest)
-        classes, codes = check_classes(type(self).__name__, y, collection.n_series)
-        unit, scale = unit_frame(collection)
-        training = TrainingSet.build(unit, representations, codes, len(classes))
+        data = training_data(type(self).__name__, X, y, params)
         rng = check_generator(params["random_state"])
-        self._grow(training, splitters, classes, collection.manifold, rng, scale)
-        if collection.equal_length and collection.manifold.point_shape == (1,):
-            self.n_features_in_ = collection.max_length
+        self._grow(data.training, data.splitters, data.classes, data.manifold, rng, data.scale)
+        if data.n_features is not None:
+            self.n_features_in_ = data.n_features
         return self
 
     def _grow(
@@ -311,6 +306,35 @@ class ProximityTree(ClassifierMixin, BaseEstimator):
         tags.input_tags.allow_nan = False
         tags.non_deterministic = False
         return tags
+
+
+@dataclass(frozen=True, eq=False)
+class TrainingData:
+    """What a tree or a forest grows from: the resolved splitters, the training set in
+    the representations they read (divided by ``scale``), the classes, the manifold,
+    and the time points of equal-length univariate series (``n_features_in_``)."""
+
+    splitters: tuple[Splitter, ...]
+    training: TrainingSet
+    classes: np.ndarray
+    manifold: Manifold
+    scale: float
+    n_features: int | None
+
+
+def training_data(estimator: str, X: Any, y: Any, params: Mapping[str, Any]) -> TrainingData:
+    """Checked parameters and training data of a tree or a forest (``estimator`` names
+    it in errors), in the form its trees grow from."""
+    splitters = resolve_splitters(params)
+    representations = representations_read(splitters)
+    shortest = 2 if "velocity" in representations else 1
+    collection = check_series_collection(X, params["manifold"], min_length=shortest)
+    classes, codes = check_classes(estimator, y, collection.n_series)
+    unit, scale = unit_frame(collection)
+    training = TrainingSet.build(unit, representations, codes, len(classes))
+    univariate = collection.equal_length and collection.manifold.point_shape == (1,)
+    return TrainingData(splitters, training, classes, collection.manifold, scale,
+                        collection.max_length if univariate else None)  # fmt: skip
 
 
 def prepare_representations(

@@ -9,11 +9,20 @@ door; the forest's shapelet splits draw and score shapelets through it.
 
 from ._classifier import GeodesicShapeletClassifier
 from ._shapelet import FEATURES, Shapelet, ShapeletBank, draw_shapelets, features, profile
-from ._transform import GeodesicShapeletTransform, default_length
+from ._transform import (
+    LENGTHS,
+    NORMALISED_FRACTION,
+    THRESHOLD_PERCENTILES,
+    GeodesicShapeletTransform,
+    default_length,
+)
 from ._windows import Windows, gather_windows, window_space
 
 __all__ = [
     "FEATURES",
+    "LENGTHS",
+    "NORMALISED_FRACTION",
+    "THRESHOLD_PERCENTILES",
     "GeodesicShapeletClassifier",
     "GeodesicShapeletTransform",
     "Shapelet",

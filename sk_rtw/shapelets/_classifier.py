@@ -5,14 +5,15 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from sklearn.base import BaseEstimator, ClassifierMixin, clone, is_classifier
+from sklearn.base import BaseEstimator, ClassifierMixin, clone
 from sklearn.pipeline import Pipeline, make_pipeline
 from sklearn.preprocessing import StandardScaler
 from sklearn.utils.validation import check_is_fitted
 
 from ..estimators import RidgeGCVClassifier
 from ..utils import check_classes, check_series_collection
-from ..utils._constraints import Constant, Satisfies
+from ..utils._common_params import CLASSIFIER
+from ..utils._constraints import Constant
 from ..utils._params import Parameter, declare_parameters, validate_parameters
 from ._transform import SHAPELET_DEFAULTS, SHAPELET_PARAMETERS, GeodesicShapeletTransform
 
@@ -23,21 +24,11 @@ if TYPE_CHECKING:
 ALPHAS = tuple(float(a) for a in np.logspace(-4, 4, 20))
 
 
-def _is_classifier(value: Any) -> bool:
-    if not (hasattr(value, "fit") and hasattr(value, "predict")):
-        return False
-    try:
-        return bool(is_classifier(value))
-    except AttributeError:
-        return False
-
-
 READOUT = Parameter(
     "readout",
     (
         Constant(None, "the default readout"),
-        Satisfies("classifier", "a scikit-learn classifier (fit, predict)",
-                  predicate=_is_classifier),
+        CLASSIFIER,
     ),
     "Classifier fitted on the shapelet features; cloned in fit. None: StandardScaler then "
     "RidgeGCVClassifier with RDST's penalties (20 from 1e-4 to 1e4), RDST's readout.",

@@ -54,6 +54,32 @@ def _is_percentiles(value: Any) -> bool:
     )
 
 
+LENGTHS = Parameter(
+    "lengths",
+    (
+        Constant(None, "min(max(2, T // 2), 11) of the shortest series"),
+        Satisfies("sequence of int", "a non-empty sequence of integers >= 1",
+                  predicate=_is_lengths),
+    ),
+    "Points of a shapelet, drawn uniformly from these (each at most the shortest "
+    "training series' length).",
+)
+NORMALISED_FRACTION = Parameter(
+    "normalised_fraction",
+    (Interval(float, 0.0, 1.0),),
+    "Probability that a shapelet compares shape without position: its windows "
+    "normalised by the manifold (mean and scale on R^d, a left translation on unit "
+    "quaternions, a congruence on SPD, each factor of a product; "
+    ":meth:`~sk_rtw.manifolds.Manifold.normalise_windows`). On a space without a "
+    "normalisation (spheres S^d, d < 3) every shapelet compares points as they are.",
+)
+THRESHOLD_PERCENTILES = Parameter(
+    "threshold_percentiles",
+    (Satisfies("(float, float)", "two percentiles 0 <= low <= high <= 100",
+               predicate=_is_percentiles),),
+    "A shapelet's occurrence threshold is drawn uniformly between these percentiles "
+    "of its distances to the windows of another training series of its class.",
+)
 SHAPELET_PARAMETERS = (
     MANIFOLD,
     Parameter(
@@ -61,25 +87,8 @@ SHAPELET_PARAMETERS = (
         (Interval(int, 1),),
         "Shapelets drawn; three features each (RDST's 10,000 by default).",
     ),
-    Parameter(
-        "lengths",
-        (
-            Constant(None, "min(max(2, T // 2), 11) of the shortest series"),
-            Satisfies("sequence of int", "a non-empty sequence of integers >= 1",
-                      predicate=_is_lengths),
-        ),
-        "Points of a shapelet, drawn uniformly from these (each at most the shortest "
-        "training series' length).",
-    ),
-    Parameter(
-        "normalised_fraction",
-        (Interval(float, 0.0, 1.0),),
-        "Probability that a shapelet compares shape without position: its windows "
-        "normalised by the manifold (mean and scale on R^d, a left translation on unit "
-        "quaternions, a congruence on SPD, each factor of a product; "
-        ":meth:`~sk_rtw.manifolds.Manifold.normalise_windows`). On a space without a "
-        "normalisation (spheres S^d, d < 3) every shapelet compares points as they are.",
-    ),
+    LENGTHS,
+    NORMALISED_FRACTION,
     Parameter(
         "representation",
         (Options((*REPRESENTATION_VALUES, DEPRECATED_BOTH)),),
@@ -87,13 +96,7 @@ SHAPELET_PARAMETERS = (
         '"auto" either, shapelet by shapelet (uniformly; the readout weighs them). "both", '
         "the forest's former word for it, is deprecated.",
     ),
-    Parameter(
-        "threshold_percentiles",
-        (Satisfies("(float, float)", "two percentiles 0 <= low <= high <= 100",
-                   predicate=_is_percentiles),),
-        "A shapelet's occurrence threshold is drawn uniformly between these percentiles "
-        "of its distances to the windows of another training series of its class.",
-    ),
+    THRESHOLD_PERCENTILES,
     N_JOBS,
     RANDOM_STATE,
     VERBOSE,

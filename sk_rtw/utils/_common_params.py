@@ -6,6 +6,7 @@ from numbers import Integral
 from typing import Any
 
 import numpy as np
+from sklearn.base import is_classifier
 
 from ..manifolds import Manifold
 from ._constraints import Boolean, Constant, InstanceOf, Interval, Satisfies
@@ -22,6 +23,20 @@ def _seed_like(value: Any) -> bool:
     )
 
 
+def _is_classifier(value: Any) -> bool:
+    """A scikit-learn classifier: fit, predict and the classifier tag."""
+    if not (hasattr(value, "fit") and hasattr(value, "predict")):
+        return False
+    try:
+        return bool(is_classifier(value))
+    except AttributeError:  # no scikit-learn tags
+        return False
+
+
+#: A readout's values: a scikit-learn classifier.
+CLASSIFIER = Satisfies(
+    "classifier", "a scikit-learn classifier (fit, predict)", predicate=_is_classifier
+)
 MANIFOLD = Parameter(
     "manifold",
     (
