@@ -364,11 +364,17 @@ def _fit_minirocket(train, test, config):
         ) from exc
     length = int(train.lengths.max())
     classifier = MiniRocketClassifier(random_state=config.seed, n_jobs=1)
+    return _fit_timed(classifier, to_aeon(equal_length(train.X, length)), train.y,
+                      to_aeon(equal_length(test.X, length)))  # fmt: skip
+
+
+def _fit_timed(classifier, X_train, y_train, X_test) -> dict:
+    """Fit and predict one classifier; its predictions, classes and seconds."""
     start = time.perf_counter()
-    classifier.fit(to_aeon(equal_length(train.X, length)), train.y)
+    classifier.fit(X_train, y_train)
     fit_seconds = time.perf_counter() - start
     start = time.perf_counter()
-    predictions = classifier.predict(to_aeon(equal_length(test.X, length)))
+    predictions = classifier.predict(X_test)
     return {
         "fit_seconds": fit_seconds,
         "predict_seconds": time.perf_counter() - start,
@@ -381,18 +387,7 @@ def _fit_minirocket(train, test, config):
 def _fit_shapelets(train, test, config):
     """GeodesicShapeletClassifier() on one thread."""
     classifier = GeodesicShapeletClassifier(random_state=config.seed, n_jobs=1)
-    start = time.perf_counter()
-    classifier.fit(train.X, train.y)
-    fit_seconds = time.perf_counter() - start
-    start = time.perf_counter()
-    predictions = classifier.predict(test.X)
-    return {
-        "fit_seconds": fit_seconds,
-        "predict_seconds": time.perf_counter() - start,
-        "predictions": predictions,
-        "classes": classifier.classes_,
-        "parameters": repr(classifier),
-    }
+    return _fit_timed(classifier, train.X, train.y, test.X)
 
 
 def _fit_rdst(train, test, config):
@@ -402,18 +397,7 @@ def _fit_rdst(train, test, config):
     except ImportError as exc:  # pragma: no cover - the benchmark needs aeon for its data
         raise ImportError("the rdst row needs aeon (pip install 'sk-rtw[benchmarks]')") from exc
     classifier = RDSTClassifier(random_state=config.seed, n_jobs=1)
-    start = time.perf_counter()
-    classifier.fit(to_aeon(train.X), train.y)
-    fit_seconds = time.perf_counter() - start
-    start = time.perf_counter()
-    predictions = classifier.predict(to_aeon(test.X))
-    return {
-        "fit_seconds": fit_seconds,
-        "predict_seconds": time.perf_counter() - start,
-        "predictions": predictions,
-        "classes": classifier.classes_,
-        "parameters": repr(classifier),
-    }
+    return _fit_timed(classifier, to_aeon(train.X), train.y, to_aeon(test.X))
 
 
 def _fit_1nn_band(train, test, config):
