@@ -27,9 +27,13 @@ from ..manifolds._point_kernels import (
     segment_codes,
 )
 
-# this package's kernels inline the manifolds' point geometry: compiled afresh after an
-# edit there (numba itself watches only each kernel's own file)
-drop_stale_caches(Path(__file__).parent, _point_kernels.compiled_sources())
+# this package's kernels inline the manifolds' point geometry and one another (the search
+# inlines the pruned recursion): compiled afresh after an edit to any of them (numba
+# itself watches only each kernel's own file)
+drop_stale_caches(
+    Path(__file__).parent,
+    [*_point_kernels.compiled_sources(), *sorted(Path(__file__).parent.glob("*.py"))],
+)
 
 __all__ = [
     "FLAT",

@@ -12,11 +12,13 @@ one compiled call.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit, prange
 
-from ._kernels import _amerced_cell, _band_row, _cell, _two_rows, choose_step, sakoe_chiba_rows
-from ._point_costs import _cost_row, _roots
+from ._kernels import _band_row, _two_rows, choose_step, sakoe_chiba_rows
+from ._point_costs import FLAT, _cost_row, _roots
 
 _INF = np.inf
 
@@ -31,16 +33,19 @@ def _pruned_row(x, y, i, prev, cur, costs, lo, hi, reach, bound, segments, squar
                 root):  # fmt: skip
     """Row ``i`` of the accumulated cost into ``cur`` (padded as in :func:`_accumulate_row`)
     from column ``lo`` on, skipping what cannot beat ``bound`` (PrunedDTW: Silva and
-    Batista, 2016). ``costs`` is a scratch row of at least ``hi`` entries; ``penalty`` is
-    amerced DTW's (:func:`~._kernels._cell`: a non-negative penalty keeps every argument
-    below); with ``root`` every point cost is the square root of its distance
+    Batista, 2016; the two phases of a row as in EAP, Herrmann and Webb, 2021).
+    ``costs`` is a scratch row of at least ``hi`` entries; ``penalty`` is amerced DTW's
+    (:func:`~._kernels._cell`: a non-negative penalty keeps every argument below); with
+    ``root`` every point cost is the square root of its distance
     (:func:`~._point_costs._roots`; with ``squared=False``).
 
     A cell is "kept" when its accumulated cost is at most ``bound``. ``reach`` is the last
-    kept column of the row above plus one: past it the cells above and above-left exceed
-    the bound, so the first cell there that exceeds it ends the row (every cell to its
-    right would too). Returns the first and last kept columns (-1 if none) and the last
-    column written.
+    kept column of the row above plus one: before it every cell is computed; from it on
+    the cells above and above-left exceed the bound, so the first cell there that exceeds
+    it ends the row (every cell to its right would too). Returns the first and last kept
+    columns (-1 if none) and the last column written. Univariate series compute their
+    point costs inside the loop; the others a chunk of :data:`PRUNE_CHUNK` columns at a
+    time past ``reach`` (a row that stops early wastes at most that many).
     """
     if bound == _INF:  # nothing to skip: the plain recursion
         _cost_row(x, y[lo:hi], i, hi - lo, segments, squared, costs[lo:hi])
@@ -48,26 +53,106 @@ def _pruned_row(x, y, i, prev, cur, costs, lo, hi, reach, bound, segments, squar
             _roots(costs[lo:hi], hi - lo)
         _band_row(costs, prev, cur, lo, hi, penalty)
         return lo, hi - 1, hi - 1
+    if _univariate(segments):
+        return _pruned_row_univariate(x[i, 0], y, prev, cur, lo, hi, reach, bound, squared,
+                                      penalty, root)  # fmt: skip
     left = _INF
     first, last = -1, -1
-    for chunk in range(lo, hi, PRUNE_CHUNK):
+    inner = min(max(reach, lo), hi)  # columns before it cannot end the row
+    _cost_row(x, y[lo:inner], i, inner - lo, segments, squared, costs[lo:inner])
+    if root:
+        _roots(costs[lo:inner], inner - lo)
+    for j in range(lo, inner):
+        left = _any_cell(prev[j], prev[j + 1], left, costs[j], penalty)
+        cur[j + 1] = left
+        if left <= bound:
+            if first < 0:
+                first = j
+            last = j
+    for chunk in range(inner, hi, PRUNE_CHUNK):
         stop = min(hi, chunk + PRUNE_CHUNK)
         _cost_row(x, y[chunk:stop], i, stop - chunk, segments, squared, costs[chunk:stop])
         if root:
             _roots(costs[chunk:stop], stop - chunk)
         for j in range(chunk, stop):
-            if penalty == 0.0:
-                left = _cell(prev, left, j, costs[j])
-            else:
-                left = _amerced_cell(prev, left, j, costs[j], penalty)
+            left = _any_cell(prev[j], prev[j + 1], left, costs[j], penalty)
             cur[j + 1] = left
-            if left <= bound:
-                if first < 0:
-                    first = j
-                last = j
-            elif j >= reach:
+            if left > bound:
                 return first, last, j
+            if first < 0:
+                first = j
+            last = j
     return first, last, hi - 1
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _pruned_row_univariate(a, y, prev, cur, lo, hi, reach, bound, squared, penalty, root):
+    """:func:`_pruned_row` of one Euclidean coordinate (``a``: the row's sample), each
+    point cost computed where the recursion reads it, as :func:`~._point_costs._cost_row`
+    computes it (``|a - b|``, squared or its square root)."""
+    left = _INF
+    first, last = -1, -1
+    inner = min(max(reach, lo), hi)
+    j = lo
+    while j < inner:  # up to the first kept cell
+        left = _any_cell(prev[j], prev[j + 1], left, _gap_cost(a, y[j, 0], squared, root), penalty)
+        cur[j + 1] = left
+        j += 1
+        if left <= bound:
+            first = last = j - 1
+            break
+    while j < inner:
+        left = _any_cell(prev[j], prev[j + 1], left, _gap_cost(a, y[j, 0], squared, root), penalty)
+        cur[j + 1] = left
+        if left <= bound:
+            last = j
+        j += 1
+    while j < hi:
+        left = _any_cell(prev[j], prev[j + 1], left, _gap_cost(a, y[j, 0], squared, root), penalty)
+        cur[j + 1] = left
+        if left > bound:
+            return first, last, j
+        if first < 0:
+            first = j
+        last = j
+        j += 1
+    return first, last, hi - 1
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _gap_cost(a, b, squared, root):
+    """The point cost of two univariate samples, bit for bit :func:`~._point_costs.
+    _cost_row`'s (and :func:`~._point_costs._roots`'s)."""
+    diff = abs(a - b)
+    cost = diff * diff if squared else diff
+    return math.sqrt(cost) if root else cost
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _univariate(segments):
+    """Whether the point is one Euclidean coordinate."""
+    return segments.shape[0] == 1 and segments[0, 2] == FLAT and segments[0, 1] == 1
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _any_cell(diagonal, up, left, cost, penalty):
+    """:func:`~._kernels._cell`, or :func:`~._kernels._amerced_cell` with a penalty, of
+    the cells above-left, above and left given as numbers (an array passed to an inlined
+    function is reference-counted at every cell: several times the recursion's cost)."""
+    best = diagonal
+    if penalty == 0.0:
+        if up < best:
+            best = up
+        if left < best:
+            best = left
+        return cost + best
+    step = up + penalty
+    if step < best:
+        best = step
+    step = left + penalty
+    if step < best:
+        best = step
+    return cost + best
 
 
 @njit(cache=True, nogil=True)
@@ -140,7 +225,101 @@ def pruned_distance(x, y, segments, squared, window, bound, penalty=0.0, root=Fa
             prev, cur = cur, prev
         return prev[y.shape[0]]
     lo, hi = sakoe_chiba_rows(x.shape[0], y.shape[0], window)
+    if _univariate(segments):
+        return _pruned_univariate(x, y, squared, lo, hi, bound, penalty, root)
     return _pruned_rows(x, y, segments, squared, lo, hi, bound, False, penalty, root)[3]
+
+
+def _univariate_kernel(squared: bool, root: bool, amerced: bool):
+    """:func:`pruned_distance` of one Euclidean coordinate for one point cost and measure
+    (compiled with them as constants: a flag tested at every cell costs a quarter of
+    the time): the rows of :func:`_pruned_rows` written out in one loop, each row's
+    phases as in :func:`_pruned_row`, every point cost computed where the recursion
+    reads it, as :func:`~._point_costs._cost_row` computes it."""
+
+    def distance(x, y, lo, hi, bound, penalty):
+        nx, ny = x.shape[0], y.shape[0]
+        prev, cur = _two_rows(ny)
+        start, reach = 0, 0
+        prev_end, cur_end = 0, 0
+        for i in range(nx):
+            a = x[i, 0]
+            j = max(lo[i], start)
+            begin, end = j, hi[i]
+            cur[j] = _INF
+            left = _INF
+            first, last = -1, -1
+            inner = min(max(reach, j), end)
+            while j < inner:  # up to the first kept cell
+                diff = abs(a - y[j, 0])
+                cost = diff * diff if squared else (math.sqrt(diff) if root else diff)
+                left = _any_cell(prev[j], prev[j + 1], left, cost, penalty if amerced else 0.0)
+                cur[j + 1] = left
+                j += 1
+                if left <= bound:
+                    first = last = j - 1
+                    break
+            while j < inner:
+                diff = abs(a - y[j, 0])
+                cost = diff * diff if squared else (math.sqrt(diff) if root else diff)
+                left = _any_cell(prev[j], prev[j + 1], left, cost, penalty if amerced else 0.0)
+                cur[j + 1] = left
+                if left <= bound:
+                    last = j
+                j += 1
+            written = inner - 1
+            while j < end:
+                diff = abs(a - y[j, 0])
+                cost = diff * diff if squared else (math.sqrt(diff) if root else diff)
+                left = _any_cell(prev[j], prev[j + 1], left, cost, penalty if amerced else 0.0)
+                cur[j + 1] = left
+                written = j
+                if left > bound:
+                    break
+                if first < 0:
+                    first = j
+                last = j
+                j += 1
+            for k in range(written + 2, cur_end + 1):
+                cur[k] = _INF
+            cur_end = max(written + 1, begin)
+            if first < 0:
+                return _INF
+            start, reach = first, last + 1
+            prev, cur = cur, prev
+            prev_end, cur_end = cur_end, prev_end
+        return prev[ny]
+
+    # a cache entry of its own for each build (numba names entries by qualified name)
+    cost = "squared" if squared else "root" if root else "plain"
+    distance.__qualname__ = f"_univariate_{cost}{'_amerced' if amerced else ''}"
+    return njit(cache=True, nogil=True)(distance)
+
+
+#: :func:`_univariate_kernel` for every point cost (squared, plain, root) and measure
+#: (DTW, amerced DTW).
+_UNIVARIATE = tuple(
+    _univariate_kernel(squared, root, amerced)
+    for squared, root in ((True, False), (False, False), (False, True))
+    for amerced in (False, True)
+)
+_SQ, _SQ_AMERCED, _PLAIN, _PLAIN_AMERCED, _ROOT, _ROOT_AMERCED = _UNIVARIATE
+
+
+@njit(cache=True, nogil=True)
+def _pruned_univariate(x, y, squared, lo, hi, bound, penalty, root):
+    """:func:`pruned_distance` of one Euclidean coordinate (:func:`_univariate_kernel`)."""
+    if squared:
+        if penalty == 0.0:
+            return _SQ(x, y, lo, hi, bound, penalty)
+        return _SQ_AMERCED(x, y, lo, hi, bound, penalty)
+    if root:
+        if penalty == 0.0:
+            return _ROOT(x, y, lo, hi, bound, penalty)
+        return _ROOT_AMERCED(x, y, lo, hi, bound, penalty)
+    if penalty == 0.0:
+        return _PLAIN(x, y, lo, hi, bound, penalty)
+    return _PLAIN_AMERCED(x, y, lo, hi, bound, penalty)
 
 
 @njit(cache=True, nogil=True)
