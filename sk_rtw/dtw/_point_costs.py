@@ -78,6 +78,22 @@ def _roots(row, n):
 
 
 @njit(cache=True, nogil=True, inline="always")
+def is_univariate(segments):
+    """Whether the point is one Euclidean coordinate (its costs are ``|a - b|``)."""
+    return segments.shape[0] == 1 and segments[0, 2] == FLAT and segments[0, 1] == 1
+
+
+@njit(cache=True, nogil=True, inline="always")
+def univariate_cost(gap, squared, root):
+    """The point cost of a univariate gap ``|a - b|`` (or a bound on one): squared, its
+    square root with ``root``, or itself; bit for bit :func:`_cost_row`'s then
+    :func:`_roots`'."""
+    if root:
+        gap = math.sqrt(gap)
+    return gap * gap if squared else gap
+
+
+@njit(cache=True, nogil=True, inline="always")
 def _cost_row(x, y, i, ny, segments, squared, row):
     """Row ``i`` of the cost matrix: point costs between ``x[i]`` and ``y[:ny]``."""
     xi = x[i]
@@ -146,8 +162,13 @@ def diagonal_cost(x, y, segments, squared, root=False):
     """
     nx, ny = x.shape[0], y.shape[0]
     steps = max(nx, ny)
-    cost = np.empty(1)
     total = 0.0
+    if is_univariate(segments):
+        for t in range(steps):
+            gap = abs(x[t * nx // steps, 0] - y[t * ny // steps, 0])
+            total = univariate_cost(gap, squared, root) + total
+        return total
+    cost = np.empty(1)
     for t in range(steps):
         j = t * ny // steps
         _cost_row(x, y[j : j + 1], t * nx // steps, 1, segments, squared, cost)

@@ -12,13 +12,11 @@ one compiled call.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numba import njit, prange
 
 from ._kernels import _band_row, _two_rows, choose_step, sakoe_chiba_rows
-from ._point_costs import FLAT, _cost_row, _roots
+from ._point_costs import _cost_row, _roots, is_univariate, univariate_cost
 
 _INF = np.inf
 
@@ -53,7 +51,7 @@ def _pruned_row(x, y, i, prev, cur, costs, lo, hi, reach, bound, segments, squar
             _roots(costs[lo:hi], hi - lo)
         _band_row(costs, prev, cur, lo, hi, penalty)
         return lo, hi - 1, hi - 1
-    if _univariate(segments):
+    if is_univariate(segments):
         return _pruned_row_univariate(x[i, 0], y, prev, cur, lo, hi, reach, bound, squared,
                                       penalty, root)  # fmt: skip
     left = _INF
@@ -95,20 +93,23 @@ def _pruned_row_univariate(a, y, prev, cur, lo, hi, reach, bound, squared, penal
     inner = min(max(reach, lo), hi)
     j = lo
     while j < inner:  # up to the first kept cell
-        left = _any_cell(prev[j], prev[j + 1], left, _gap_cost(a, y[j, 0], squared, root), penalty)
+        cost = univariate_cost(abs(a - y[j, 0]), squared, root)
+        left = _any_cell(prev[j], prev[j + 1], left, cost, penalty)
         cur[j + 1] = left
         j += 1
         if left <= bound:
             first = last = j - 1
             break
     while j < inner:
-        left = _any_cell(prev[j], prev[j + 1], left, _gap_cost(a, y[j, 0], squared, root), penalty)
+        cost = univariate_cost(abs(a - y[j, 0]), squared, root)
+        left = _any_cell(prev[j], prev[j + 1], left, cost, penalty)
         cur[j + 1] = left
         if left <= bound:
             last = j
         j += 1
     while j < hi:
-        left = _any_cell(prev[j], prev[j + 1], left, _gap_cost(a, y[j, 0], squared, root), penalty)
+        cost = univariate_cost(abs(a - y[j, 0]), squared, root)
+        left = _any_cell(prev[j], prev[j + 1], left, cost, penalty)
         cur[j + 1] = left
         if left > bound:
             return first, last, j
@@ -117,21 +118,6 @@ def _pruned_row_univariate(a, y, prev, cur, lo, hi, reach, bound, squared, penal
         last = j
         j += 1
     return first, last, hi - 1
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _gap_cost(a, b, squared, root):
-    """The point cost of two univariate samples, bit for bit :func:`~._point_costs.
-    _cost_row`'s (and :func:`~._point_costs._roots`'s)."""
-    diff = abs(a - b)
-    cost = diff * diff if squared else diff
-    return math.sqrt(cost) if root else cost
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _univariate(segments):
-    """Whether the point is one Euclidean coordinate."""
-    return segments.shape[0] == 1 and segments[0, 2] == FLAT and segments[0, 1] == 1
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -225,7 +211,7 @@ def pruned_distance(x, y, segments, squared, window, bound, penalty=0.0, root=Fa
             prev, cur = cur, prev
         return prev[y.shape[0]]
     lo, hi = sakoe_chiba_rows(x.shape[0], y.shape[0], window)
-    if _univariate(segments):
+    if is_univariate(segments):
         return _pruned_univariate(x, y, squared, lo, hi, bound, penalty, root)
     return _pruned_rows(x, y, segments, squared, lo, hi, bound, False, penalty, root)[3]
 
@@ -251,8 +237,7 @@ def _univariate_kernel(squared: bool, root: bool, amerced: bool):
             first, last = -1, -1
             inner = min(max(reach, j), end)
             while j < inner:  # up to the first kept cell
-                diff = abs(a - y[j, 0])
-                cost = diff * diff if squared else (math.sqrt(diff) if root else diff)
+                cost = univariate_cost(abs(a - y[j, 0]), squared, root)
                 left = _any_cell(prev[j], prev[j + 1], left, cost, penalty if amerced else 0.0)
                 cur[j + 1] = left
                 j += 1
@@ -260,8 +245,7 @@ def _univariate_kernel(squared: bool, root: bool, amerced: bool):
                     first = last = j - 1
                     break
             while j < inner:
-                diff = abs(a - y[j, 0])
-                cost = diff * diff if squared else (math.sqrt(diff) if root else diff)
+                cost = univariate_cost(abs(a - y[j, 0]), squared, root)
                 left = _any_cell(prev[j], prev[j + 1], left, cost, penalty if amerced else 0.0)
                 cur[j + 1] = left
                 if left <= bound:
@@ -269,8 +253,7 @@ def _univariate_kernel(squared: bool, root: bool, amerced: bool):
                 j += 1
             written = inner - 1
             while j < end:
-                diff = abs(a - y[j, 0])
-                cost = diff * diff if squared else (math.sqrt(diff) if root else diff)
+                cost = univariate_cost(abs(a - y[j, 0]), squared, root)
                 left = _any_cell(prev[j], prev[j + 1], left, cost, penalty if amerced else 0.0)
                 cur[j + 1] = left
                 written = j

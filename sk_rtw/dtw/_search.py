@@ -64,6 +64,10 @@ _INF = np.inf
 #: A reference is skipped when its bound exceeds the best distance so far by this
 #: relative margin or more (the bound and the distance are rounded differently).
 LB_SLACK = 1e-12
+#: Queries are searched in at most this many blocks, each allocating its buffers once.
+QUERY_BLOCKS = 64
+#: Up to this many references are ordered by insertion sort (no allocation).
+SMALL_SORT = 32
 
 
 @njit(cache=True, nogil=True)
@@ -132,8 +136,8 @@ def _box_cost(point, lower, upper, segments, squared, root):
     box, turned into a bound on the segment's distance; ``root``: costs are the square
     roots of the distances, an increasing function of them too)."""
     n_segments = segments.shape[0]
-    if _univariate(segments):
-        return _gap_cost(outside(point[0], lower[0], upper[0]), squared, root)
+    if _point_costs.is_univariate(segments):
+        return _point_costs.univariate_cost(outside(point[0], lower[0], upper[0]), squared, root)
     sq = 0.0
     for s in range(n_segments):
         sq += box_squared_bound(point, lower, upper, segments[s, 0], segments[s, 1],
@@ -147,31 +151,14 @@ def lb_keogh(y, lower, upper, segments, squared, root=False):
     """LB_Keogh of reference ``y`` (``(T_y, p)``) against a query's envelope
     (:func:`query_envelope`), in the point cost of ``segments`` (module docstring)."""
     total = 0.0
-    if _univariate(segments):  # one coordinate: the gap itself, in a tight loop
+    if _point_costs.is_univariate(segments):  # one coordinate: the gap itself, in a tight loop
         for j in range(y.shape[0]):
-            total += _gap_cost(outside(y[j, 0], lower[j, 0], upper[j, 0]), squared, root)
+            gap = outside(y[j, 0], lower[j, 0], upper[j, 0])
+            total += _point_costs.univariate_cost(gap, squared, root)
         return total
     for j in range(y.shape[0]):
         total += _box_cost(y[j], lower[j], upper[j], segments, squared, root)
     return total
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _univariate(segments):
-    """Whether the point is one Euclidean coordinate."""
-    return (
-        segments.shape[0] == 1
-        and segments[0, 2] == _point_costs.FLAT
-        and segments[0, 1] == 1
-    )
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _gap_cost(gap, squared, root):
-    """The point cost of a univariate gap (:func:`_box_cost`'s first case)."""
-    if root:
-        gap = math.sqrt(gap)
-    return gap * gap if squared else gap
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -216,82 +203,118 @@ def _nearest_by_class(
     out = np.full((n_q, n_classes), _INF)
     computed = np.zeros(n_q, dtype=np.int64)
     by_length = np.argsort(lr, kind="mergesort")  # envelopes computed once per length
-    for q in prange(n_q):
-        x = Q[q, : lq[q]]
+    n_blocks = min(n_q, QUERY_BLOCKS)
+    for block in prange(n_blocks):  # the buffers of a block's queries allocated once
         lower = np.empty((R.shape[1], p))
         upper = np.empty((R.shape[1], p))
-        scratch = np.empty(4 * lq[q] + 2 * R.shape[1], dtype=np.int64)
+        scratch = np.empty(4 * Q.shape[1] + 2 * R.shape[1], dtype=np.int64)
         narrow_lower = np.empty((R.shape[1] if penalty > 0.0 else 0, p))
         narrow_upper = np.empty((R.shape[1] if penalty > 0.0 else 0, p))
-        enveloped, enveloped_length = -2.0, -1  # the band and length of that envelope
         candidates = np.empty(n_r, dtype=np.int64)
         bounds = np.empty(n_r)
+        order = np.empty(n_r, dtype=np.int64)
         available = np.zeros(n_classes, dtype=np.bool_)
-        n = 0
-        current = -1
-        for r in by_length:
-            if r == skip_reference[q] or owners[r] == skip_class[q]:
-                continue
-            if lr[r] != current:
-                current = lr[r]
-                _envelope(x, current, window, lower, upper, scratch)
-            candidates[n] = r
-            bounds[n] = lb_keogh(R[r, : lr[r]], lower, upper, segments, squared, root)
-            available[owners[r]] = True
-            n += 1
-        best = out[q]
-        nearest = limits[q]  # the least distance found (or the limit)
-        worst = limits[q] if every_class else nearest  # no class can improve above it
-        for position in np.argsort(bounds[:n], kind="mergesort"):
-            bound = bounds[position] * (1.0 - LB_SLACK)
-            if bound > worst:
-                break
-            r = candidates[position]
-            c = owners[r]
-            threshold = min(best[c], limits[q]) if every_class else nearest
-            if bound > threshold:
-                continue
-            y = R[r, : lr[r]]
-            cut = threshold
-            if (window < 0.0 or window >= 1.0 or x.shape[0] == y.shape[0]) and cut > 0.0:
-                # the diagonal path lies in the band: its cost bounds this pair's distance
-                diagonal = _point_costs.diagonal_cost(x, y, segments, squared, root)
-                diagonal += penalty * abs(x.shape[0] - y.shape[0])
-                cut = min(cut, diagonal * (1.0 + LB_SLACK))
-            band = _amerced_band(x.shape[0], y.shape[0], window, penalty, cut)
-            if band != window and threshold < _INF:
-                # the paths that can beat the threshold lie in the narrower band: its
-                # LB_Keogh may rule the pair out (the full band's seldom does); the query's
-                # envelope in it changes only with the band
-                narrow = _amerced_band(x.shape[0], y.shape[0], window, penalty, threshold)
-                if narrow != enveloped or y.shape[0] != enveloped_length:
-                    _envelope(x, y.shape[0], narrow, narrow_lower, narrow_upper, scratch)
-                    enveloped, enveloped_length = narrow, y.shape[0]
-                bound = lb_keogh(y, narrow_lower, narrow_upper, segments, squared, root)
-                if bound * (1.0 - LB_SLACK) > threshold:
-                    continue
-            value = _pruned.pruned_distance(x, y, segments, squared, band, cut, penalty, root)
-            if value > cut and cut < threshold:  # rounding beat the slack: bound it again
-                band = _amerced_band(x.shape[0], y.shape[0], window, penalty, threshold)
-                value = _pruned.pruned_distance(x, y, segments, squared, band, threshold,
-                                                penalty, root)  # fmt: skip
-            computed[q] += 1
-            if value <= threshold and value < best[c]:
-                best[c] = value
-                nearest = min(nearest, value)
-                if every_class:
-                    worst = 0.0
-                    for k in range(n_classes):
-                        if available[k] and best[k] > worst:
-                            worst = best[k]
-                    worst = min(worst, limits[q])
-                else:
-                    worst = nearest
-        if not every_class:
-            for k in range(n_classes):
-                if best[k] > nearest:
-                    best[k] = _INF
+        for q in range(block * n_q // n_blocks, (block + 1) * n_q // n_blocks):
+            _search_query(
+                q, Q[q, : lq[q]], R, lr, owners, n_classes, skip_reference, skip_class,
+                limits, every_class, segments, squared, window, penalty, root, by_length,
+                out[q], computed, lower, upper, scratch, narrow_lower, narrow_upper,
+                candidates, bounds, order, available,
+            )  # fmt: skip
     return out, computed
+
+
+@njit(cache=True, nogil=True)
+def _search_query(
+    q, x, R, lr, owners, n_classes, skip_reference, skip_class, limits, every_class,
+    segments, squared, window, penalty, root, by_length, best, computed, lower, upper,
+    scratch, narrow_lower, narrow_upper, candidates, bounds, order, available,
+):  # fmt: skip
+    """:func:`_nearest_by_class` of query ``q`` (``x``) into ``best`` (its row of the
+    distances, ``inf``), with buffers of the caller's."""
+    enveloped, enveloped_length = -2.0, -1  # the band and length of that envelope
+    available[:] = False
+    n = 0
+    current = -1
+    for r in by_length:
+        if r == skip_reference[q] or owners[r] == skip_class[q]:
+            continue
+        if lr[r] != current:
+            current = lr[r]
+            _envelope(x, current, window, lower, upper, scratch)
+        candidates[n] = r
+        bounds[n] = lb_keogh(R[r, : lr[r]], lower, upper, segments, squared, root)
+        available[owners[r]] = True
+        n += 1
+    nearest = limits[q]  # the least distance found (or the limit)
+    worst = limits[q] if every_class else nearest  # no class can improve above it
+    _stable_order(bounds, n, order)
+    for rank in range(n):
+        position = order[rank]
+        bound = bounds[position] * (1.0 - LB_SLACK)
+        if bound > worst:
+            break
+        r = candidates[position]
+        c = owners[r]
+        threshold = min(best[c], limits[q]) if every_class else nearest
+        if bound > threshold:
+            continue
+        y = R[r, : lr[r]]
+        cut = threshold
+        if (window < 0.0 or window >= 1.0 or x.shape[0] == y.shape[0]) and cut > 0.0:
+            # the diagonal path lies in the band: its cost bounds this pair's distance
+            diagonal = _point_costs.diagonal_cost(x, y, segments, squared, root)
+            diagonal += penalty * abs(x.shape[0] - y.shape[0])
+            cut = min(cut, diagonal * (1.0 + LB_SLACK))
+        band = _amerced_band(x.shape[0], y.shape[0], window, penalty, cut)
+        if band != window and threshold < _INF:
+            # the paths that can beat the threshold lie in the narrower band: its
+            # LB_Keogh may rule the pair out (the full band's seldom does); the query's
+            # envelope in it changes only with the band
+            narrow = _amerced_band(x.shape[0], y.shape[0], window, penalty, threshold)
+            if narrow != enveloped or y.shape[0] != enveloped_length:
+                _envelope(x, y.shape[0], narrow, narrow_lower, narrow_upper, scratch)
+                enveloped, enveloped_length = narrow, y.shape[0]
+            bound = lb_keogh(y, narrow_lower, narrow_upper, segments, squared, root)
+            if bound * (1.0 - LB_SLACK) > threshold:
+                continue
+        value = _pruned.pruned_distance(x, y, segments, squared, band, cut, penalty, root)
+        if value > cut and cut < threshold:  # rounding beat the slack: bound it again
+            band = _amerced_band(x.shape[0], y.shape[0], window, penalty, threshold)
+            value = _pruned.pruned_distance(x, y, segments, squared, band, threshold,
+                                            penalty, root)  # fmt: skip
+        computed[q] += 1
+        if value <= threshold and value < best[c]:
+            best[c] = value
+            nearest = min(nearest, value)
+            if every_class:
+                worst = 0.0
+                for k in range(n_classes):
+                    if available[k] and best[k] > worst:
+                        worst = best[k]
+                worst = min(worst, limits[q])
+            else:
+                worst = nearest
+    if not every_class:
+        for k in range(n_classes):
+            if best[k] > nearest:
+                best[k] = _INF
+
+
+@njit(cache=True, nogil=True)
+def _stable_order(values, n, order):
+    """``order[:n]`` = ``np.argsort(values[:n], kind="stable")``, without allocating for
+    the few values of a node's exemplars (insertion sort up to :data:`SMALL_SORT`)."""
+    if n > SMALL_SORT:
+        order[:n] = np.argsort(values[:n], kind="mergesort")
+        return
+    for k in range(n):
+        value = values[k]
+        m = k
+        while m > 0 and values[order[m - 1]] > value:
+            order[m] = order[m - 1]
+            m -= 1
+        order[m] = k
 
 
 #: :func:`_nearest_by_class` threaded over the queries, and on the calling thread alone
