@@ -13,8 +13,11 @@ predict the test split on one thread; the CPU seconds of each (``time.process_ti
 wall time depends on what else the machine runs) are kept with the test accuracy, and
 so are the CPU seconds per test series of aeon's 1-NN DTW (full window, one thread) on at
 most ``--dtw-series`` test series. Records are JSON lines appended one dataset at a time
-(a rerun skips what is there). ``--parallel`` also times the fit with ``n_jobs=2``
-against ``n_jobs=1`` in wall seconds (the speed-up of two threads).
+(a rerun skips what is there), with the fitted forest's pickle size beside the training
+series' size and the growth of the process's peak resident memory during the fit (0
+where the peak came before it, as while loading the data). ``--parallel`` also times
+the fit with ``n_jobs=2`` against ``n_jobs=1`` in wall seconds (the speed-up of two
+threads).
 
 The summary gives, per half, the forest's total fit and prediction CPU seconds against
 Proximity Forest 2.0's C++ on the same machine kind, taken as ``--pf2-factor`` (0.6)
@@ -28,6 +31,9 @@ per series over 1-NN DTW's.
 from __future__ import annotations
 
 import argparse
+import os
+import pickle
+import resource
 import sys
 import time
 from pathlib import Path
@@ -62,6 +68,24 @@ def _wall(call) -> float:
     return time.perf_counter() - start
 
 
+def _rss_bytes() -> int:
+    """This process's resident memory now (Linux), 0 where unknown."""
+    try:
+        with open("/proc/self/statm") as handle:
+            return int(handle.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+    except (OSError, ValueError, IndexError):
+        return 0
+
+
+def _peak_rss_bytes() -> int:
+    """The largest resident memory this process has had (Linux reports kilobytes)."""
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+
+
+def _series_bytes(X) -> int:
+    return sum(np.asarray(s).nbytes for s in X) if isinstance(X, list) else np.asarray(X).nbytes
+
+
 def _aeon(X) -> np.ndarray | list[np.ndarray]:
     """Series in aeon's channels-first layout."""
     if isinstance(X, list):
@@ -76,12 +100,16 @@ def measure(name: str, seed: int, data_dir: str, args: argparse.Namespace) -> di
 
     train, test = load_split(name, "train", data_dir), load_split(name, "test", data_dir)
     forest = RTWProximityForest(random_state=seed, n_jobs=1)
+    before = _rss_bytes()
     _, fit = _cpu(lambda: forest.fit(train.X, train.y))
+    peak = max(0, _peak_rss_bytes() - before)  # 0 where the peak came before the fit
     predicted, predict = _cpu(lambda: forest.predict(test.X))
     record = {
         "dataset": name, "seed": seed, "n_train": len(train.y), "n_test": len(test.y),
         "accuracy": float(np.mean(predicted == test.y)), "fit_cpu": fit,
         "predict_cpu": predict, "predict_per_series": predict / len(test.y),
+        "train_bytes": _series_bytes(train.X), "pickle_bytes": len(pickle.dumps(forest)),
+        "fit_peak_rss_increase": peak,
     }  # fmt: skip
     if args.dtw_series > 0:
         rows = np.random.default_rng(seed).permutation(len(test.y))[: args.dtw_series]
@@ -167,11 +195,14 @@ def main(argv: list[str] | None = None) -> None:
         return measure(name, seed, data_dir, args)
 
     for record in measure_missing(args, records, one):
+        memory = (f", pickle {record['pickle_bytes'] / 1e6:.2f} MB (training series "
+                  f"{record['train_bytes'] / 1e6:.2f} MB), fit peak +"
+                  f"{record['fit_peak_rss_increase'] / 1e6:.0f} MB")  # fmt: skip
         ratio = (f", 1-NN DTW {record['predict_per_series'] / record['dtw_per_series']:.2f}x"
                  if record.get("dtw_per_series") else "")  # fmt: skip
         print(f"{record['dataset']} seed {record['seed']}: fit {record['fit_cpu']:.1f} s, "
               f"predict {record['predict_cpu']:.1f} s{ratio}, accuracy "
-              f"{record['accuracy']:.4f}", flush=True)  # fmt: skip
+              f"{record['accuracy']:.4f}{memory}", flush=True)  # fmt: skip
     print("\n".join(["", *summary(records, args)]))
 
 
