@@ -350,3 +350,50 @@ def test_long_pairs_are_bounded_by_their_coarse_to_fine_path_with_the_same_resul
     symmetric = np.triu(full, 1) + np.triu(full, 1).T  # X against itself: the upper pairs
     np.testing.assert_array_equal(dtw_pairwise_distance(X, manifold=Q), symmetric)
     np.testing.assert_array_equal(dtw_pairwise_distance(X, X[:2], manifold=Q), full[:, :2])
+
+
+def _plain_recursion(x, y, lo, hi, exponent, penalty):
+    """DTW (amerced by ``penalty``) of univariate ``x`` and ``y`` in the staircase band
+    ``[lo[i], hi[i])``, cell by cell in Python: the point cost ``|a - b| ** exponent``."""
+    D = np.full((len(x) + 1, len(y) + 1), np.inf)
+    D[0, 0] = 0.0
+    for i in range(len(x)):
+        for j in range(lo[i], hi[i]):
+            cost = abs(x[i] - y[j]) ** exponent
+            D[i + 1, j + 1] = cost + min(D[i, j], D[i, j + 1] + penalty, D[i + 1, j] + penalty)
+    return D[-1, -1]
+
+
+def test_bounded_univariate_distance_is_the_recursions_within_its_bound(rng):
+    """The univariate pruned distance (two rows side by side, each pruned by the bound)
+    returns the plain recursion's value bit for bit whenever it is at most the bound, and
+    a value above the bound otherwise: every point cost, DTW and amerced DTW, bands,
+    unequal lengths, ties (integer series), bounds at, under and over the distance."""
+    from sk_rtw.dtw import _point_costs, _pruned
+    from sk_rtw.dtw._kernels import sakoe_chiba_rows
+    from sk_rtw.manifolds import Euclidean
+
+    segments = _point_costs.segment_codes(Euclidean(1))
+    costs = ((True, False, 2.0), (False, False, 1.0), (False, True, 0.5))
+    for case in range(500):
+        nx = int(rng.integers(1, 24))
+        ny = nx if case % 2 else int(rng.integers(1, 24))
+        if case % 3 == 0:  # ties everywhere
+            x, y = rng.integers(0, 3, nx).astype(float), rng.integers(0, 3, ny).astype(float)
+        else:
+            x, y = np.cumsum(rng.normal(size=nx)), np.cumsum(rng.normal(size=ny))
+        window = (-1.0, 1.0, 0.0, float(rng.random()), 0.1)[case % 5]
+        squared, root, exponent = costs[case % 3 if case % 7 else (case // 7) % 3]
+        penalty = (0.0, float(rng.random()), 1e-3)[case % 3 if case % 4 else 0]
+        X, Y = x[:, None].copy(), y[:, None].copy()
+        exact = _pruned.pruned_distance(X, Y, segments, squared, window, np.inf, penalty, root)
+        if case < 60:  # the compiled recursion against Python's, cell by cell
+            lo, hi = sakoe_chiba_rows(nx, ny, window)
+            assert exact == pytest.approx(_plain_recursion(x, y, lo, hi, exponent, penalty),
+                                          rel=1e-12, abs=1e-12)  # fmt: skip
+        for bound in (exact * 0.3, exact * 0.9, exact, exact * (1 + 1e-12), exact * 1.5):
+            got = _pruned.pruned_distance(X, Y, segments, squared, window, bound, penalty, root)
+            if exact <= bound:
+                assert got == exact, (case, bound)
+            else:
+                assert got > bound, (case, bound)
