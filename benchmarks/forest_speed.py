@@ -7,7 +7,8 @@ Usage::
     python benchmarks/forest_speed.py --data-dir ../shared/ucr_large --halves C1 C2 \
         --out results/forest_speed_c.jsonl
 
-For every dataset of the halves and every seed, :class:`sk_rtw.RTWProximityForest`
+For every dataset of the halves and every seed (after a warm-up forest of two trees on a
+few series, so that compiling is not timed), :class:`sk_rtw.RTWProximityForest`
 (``random_state=seed``, ``n_jobs=1``, everything else default) is fitted and asked to
 predict the test split on one thread; the CPU seconds of each (``time.process_time``:
 wall time depends on what else the machine runs) are kept with the test accuracy, and
@@ -93,12 +94,22 @@ def _aeon(X) -> np.ndarray | list[np.ndarray]:
     return np.asarray(X, dtype=float)[:, None, :]
 
 
+def _warm_up(train) -> None:
+    """Two trees on a few series of every class: the kernels compiled (or loaded from
+    numba's cache) for these series before anything is timed or its memory read."""
+    rows = np.concatenate([np.flatnonzero(train.y == c)[:3] for c in np.unique(train.y)])
+    X = [train.X[i] for i in rows] if isinstance(train.X, list) else train.X[rows]
+    forest = RTWProximityForest(n_trees=2, random_state=0, n_jobs=1).fit(X, train.y[rows])
+    forest.predict(X)
+
+
 def measure(name: str, seed: int, data_dir: str, args: argparse.Namespace) -> dict:
     """One dataset and seed: the forest's CPU seconds and accuracy, 1-NN DTW's seconds
     per test series (and the two-thread fit if asked)."""
     from aeon.classification.distance_based import KNeighborsTimeSeriesClassifier
 
     train, test = load_split(name, "train", data_dir), load_split(name, "test", data_dir)
+    _warm_up(train)
     forest = RTWProximityForest(random_state=seed, n_jobs=1)
     before = _rss_bytes()
     _, fit = _cpu(lambda: forest.fit(train.X, train.y))

@@ -327,3 +327,30 @@ def test_the_velocity_representation_is_the_tangent_velocity():
     collection = check_series_collection(X)
     np.testing.assert_array_equal(represent(collection, "velocity").data[..., 0],
                                   tangent_velocity(X))  # fmt: skip
+
+
+def test_pickled_nodes_and_splits_keep_their_values_and_types():
+    """Nodes, measures and elastic splits pickle in a compact form of their own and come
+    back equal, arrays of the same dtype (series and mean exemplars)."""
+    X, y = three_classes(n_per_class=4)
+    for exemplars in ("series", "mean"):
+        forest = RTWProximityForest(n_trees=3, exemplars=exemplars, random_state=0).fit(X, y)
+        restored = pickle.loads(pickle.dumps(forest))
+        pairs = [(a.root_, b.root_) for a, b in zip(forest.trees_, restored.trees_, strict=True)]
+        while pairs:
+            node, copy = pairs.pop()
+            assert copy.distribution.dtype == np.float64
+            np.testing.assert_array_equal(copy.distribution, node.distribution)
+            assert (copy.n_series, copy.depth, copy.gain) == (node.n_series, node.depth,
+                                                              node.gain)  # fmt: skip
+            assert (copy.split is None) == (node.split is None)
+            if node.split is not None:
+                assert copy.split.measure == node.split.measure
+                for name in ("classes", "sources"):
+                    assert getattr(copy.split, name).dtype == np.int64
+                    np.testing.assert_array_equal(getattr(copy.split, name),
+                                                  getattr(node.split, name))  # fmt: skip
+                np.testing.assert_array_equal(copy.split.exemplars.data,
+                                              node.split.exemplars.data)  # fmt: skip
+            pairs += list(zip(node.children, copy.children, strict=True))
+        np.testing.assert_array_equal(restored.predict_proba(X), forest.predict_proba(X))
