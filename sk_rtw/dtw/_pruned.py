@@ -41,9 +41,9 @@ def _pruned_row(x, y, i, prev, cur, costs, lo, hi, reach, bound, segments, squar
     kept column of the row above plus one: before it every cell is computed; from it on
     the cells above and above-left exceed the bound, so the first cell there that exceeds
     it ends the row (every cell to its right would too). Returns the first and last kept
-    columns (-1 if none) and the last column written. Univariate series compute their
-    point costs inside the loop; the others a chunk of :data:`PRUNE_CHUNK` columns at a
-    time past ``reach`` (a row that stops early wastes at most that many).
+    columns (-1 if none) and the last column written. Point costs are computed for the
+    columns before ``reach`` at once, then :data:`PRUNE_CHUNK` columns at a time (a row
+    that stops early wastes at most that many).
     """
     if bound == _INF:  # nothing to skip: the plain recursion
         _cost_row(x, y[lo:hi], i, hi - lo, segments, squared, costs[lo:hi])
@@ -51,9 +51,6 @@ def _pruned_row(x, y, i, prev, cur, costs, lo, hi, reach, bound, segments, squar
             _roots(costs[lo:hi], hi - lo)
         _band_row(costs, prev, cur, lo, hi, penalty)
         return lo, hi - 1, hi - 1
-    if is_univariate(segments):
-        return _pruned_row_univariate(x[i, 0], y, prev, cur, lo, hi, reach, bound, squared,
-                                      penalty, root)  # fmt: skip
     left = _INF
     first, last = -1, -1
     inner = min(max(reach, lo), hi)  # columns before it cannot end the row
@@ -80,43 +77,6 @@ def _pruned_row(x, y, i, prev, cur, costs, lo, hi, reach, bound, segments, squar
             if first < 0:
                 first = j
             last = j
-    return first, last, hi - 1
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _pruned_row_univariate(a, y, prev, cur, lo, hi, reach, bound, squared, penalty, root):
-    """:func:`_pruned_row` of one Euclidean coordinate (``a``: the row's sample), each
-    point cost computed where the recursion reads it, as :func:`~._point_costs._cost_row`
-    computes it (``|a - b|``, squared or its square root)."""
-    left = _INF
-    first, last = -1, -1
-    inner = min(max(reach, lo), hi)
-    j = lo
-    while j < inner:  # up to the first kept cell
-        cost = univariate_cost(abs(a - y[j, 0]), squared, root)
-        left = _any_cell(prev[j], prev[j + 1], left, cost, penalty)
-        cur[j + 1] = left
-        j += 1
-        if left <= bound:
-            first = last = j - 1
-            break
-    while j < inner:
-        cost = univariate_cost(abs(a - y[j, 0]), squared, root)
-        left = _any_cell(prev[j], prev[j + 1], left, cost, penalty)
-        cur[j + 1] = left
-        if left <= bound:
-            last = j
-        j += 1
-    while j < hi:
-        cost = univariate_cost(abs(a - y[j, 0]), squared, root)
-        left = _any_cell(prev[j], prev[j + 1], left, cost, penalty)
-        cur[j + 1] = left
-        if left > bound:
-            return first, last, j
-        if first < 0:
-            first = j
-        last = j
-        j += 1
     return first, last, hi - 1
 
 
