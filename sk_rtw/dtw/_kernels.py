@@ -1,10 +1,10 @@
 """Numba kernels: the DTW recursion over a cost matrix, its band, backtracking.
 
 The recursion ``D[i, j] = C[i, j] + min(D[i-1, j], D[i, j-1], D[i-1, j-1])`` is written
-once (:func:`_cell`) and used by every DTW of the package (:mod:`._pruned` computes the
+once (:func:`cell_value`) and used by every DTW of the package (:mod:`._pruned` computes the
 point costs inside it), ties on the way back broken once (:func:`choose_step`). Amerced
 DTW (Herrmann and Webb, 2023) adds a penalty ``w`` to the steps off the diagonal,
-``min(D[i-1, j] + w, D[i, j-1] + w, D[i-1, j-1])`` (:func:`_amerced_cell`): 0 is plain
+``min(D[i-1, j] + w, D[i, j-1] + w, D[i-1, j-1])`` (:func:`cell_value`): 0 is plain
 DTW, larger penalties move the measure towards the direct, diagonal alignment. The
 kernels take ``penalty`` and run the plain cell where it is 0 (the same values, bit for
 bit). ``fastmath`` is never enabled: the band uses ``inf`` for forbidden cells.
@@ -96,34 +96,30 @@ def _band_row(cost_row, prev, cur, lo, hi, penalty):
     left = _INF
     if penalty == 0.0:  # two loops: a test per cell would slow plain DTW by 40 %
         for j in range(lo, hi):
-            left = _cell(prev, left, j, cost_row[j])
+            left = cell_value(prev[j], prev[j + 1], left, cost_row[j], 0.0)
             cur[j + 1] = left
     else:
         for j in range(lo, hi):
-            left = _amerced_cell(prev, left, j, cost_row[j], penalty)
+            left = cell_value(prev[j], prev[j + 1], left, cost_row[j], penalty)
             cur[j + 1] = left
 
 
-@njit(cache=True, nogil=True)
-def _cell(prev, left, j, cost):
-    """The recursion at column ``j``: ``cost`` plus the least of the cells above-left
-    (``prev[j]``), above (``prev[j + 1]``) and left, in padded rows."""
-    best = prev[j]
-    if prev[j + 1] < best:
-        best = prev[j + 1]
-    if left < best:
-        best = left
-    return cost + best
-
-
-@njit(cache=True, nogil=True)
-def _amerced_cell(prev, left, j, cost, penalty):
-    """:func:`_cell` of amerced DTW: the cells above and left each with ``penalty``
-    added (with 0, the value of :func:`_cell`)."""
-    best = prev[j]
-    up = prev[j + 1] + penalty
-    if up < best:
-        best = up
+@njit(cache=True, nogil=True, inline="always")
+def cell_value(diagonal, up, left, cost, penalty):
+    """The recursion at one cell: ``cost`` plus the least of the cells above-left, above
+    and left, the last two with amerced DTW's ``penalty`` added (0: plain DTW, compared
+    in the same order). The neighbours come as numbers: an array handed to an inlined
+    function is reference-counted at every cell, several times the recursion's cost."""
+    best = diagonal
+    if penalty == 0.0:
+        if up < best:
+            best = up
+        if left < best:
+            best = left
+        return cost + best
+    step = up + penalty
+    if step < best:
+        best = step
     step = left + penalty
     if step < best:
         best = step

@@ -8,7 +8,7 @@ buffer holding reference ``l``: ``L`` independent chains that the compiler vecto
 at the throughput of the vector units instead of the latency of one chain.
 
 Every lane performs, for its pair, the operations of the one-pair kernels
-(:func:`~._point_costs._cost_row`, :func:`~._kernels._cell`) in the same order, so the
+(:func:`~._point_costs._cost_row`, :func:`~._kernels.cell_value`) in the same order, so the
 distances are those of :func:`~._pruned.pairwise_segments` bit for bit. Only point
 distances made of flat segments (squared coordinate differences) are computed in lanes
 (their cost is a few instructions; any other segment's cost dominates its cell anyway).
@@ -107,7 +107,7 @@ def lane_blocks(lengths: np.ndarray) -> tuple[list[np.ndarray], np.ndarray]:
 
 @njit(cache=True, nogil=True, inline="always")
 def _step(prev, left, c, lane, cost):
-    """:func:`~._kernels._cell` in one lane: the same comparisons, the same sum."""
+    """:func:`~._kernels.cell_value` in one lane: the same comparisons, the same sum."""
     best = prev[c, lane]
     if prev[c + 1, lane] < best:
         best = prev[c + 1, lane]
@@ -118,7 +118,7 @@ def _step(prev, left, c, lane, cost):
 
 @njit(cache=True, nogil=True, inline="always")
 def _amerced_step(prev, left, c, lane, cost, penalty):
-    """:func:`~._kernels._amerced_cell` in one lane: the same comparisons, the same sums."""
+    """:func:`~._kernels.cell_value` in one lane: the same comparisons, the same sums."""
     best = prev[c, lane]
     up = prev[c + 1, lane] + penalty
     if up < best:

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from ._kernels import _band_row, _two_rows, choose_step, sakoe_chiba_rows
+from ._kernels import _band_row, _two_rows, cell_value, choose_step, sakoe_chiba_rows
 from ._point_costs import _cost_row, _roots, is_univariate, univariate_cost
 
 _INF = np.inf
@@ -33,7 +33,7 @@ def _pruned_row(x, y, i, prev, cur, costs, lo, hi, reach, bound, segments, squar
     from column ``lo`` on, skipping what cannot beat ``bound`` (PrunedDTW: Silva and
     Batista, 2016; the two phases of a row as in EAP, Herrmann and Webb, 2021).
     ``costs`` is a scratch row of at least ``hi`` entries; ``penalty`` is amerced DTW's
-    (:func:`~._kernels._cell`: a non-negative penalty keeps every argument below); with
+    (:func:`~._kernels.cell_value`: a non-negative penalty keeps every argument below); with
     ``root`` every point cost is the square root of its distance
     (:func:`~._point_costs._roots`; with ``squared=False``).
 
@@ -58,7 +58,7 @@ def _pruned_row(x, y, i, prev, cur, costs, lo, hi, reach, bound, segments, squar
     if root:
         _roots(costs[lo:inner], inner - lo)
     for j in range(lo, inner):
-        left = _any_cell(prev[j], prev[j + 1], left, costs[j], penalty)
+        left = cell_value(prev[j], prev[j + 1], left, costs[j], penalty)
         cur[j + 1] = left
         if left <= bound:
             if first < 0:
@@ -70,7 +70,7 @@ def _pruned_row(x, y, i, prev, cur, costs, lo, hi, reach, bound, segments, squar
         if root:
             _roots(costs[chunk:stop], stop - chunk)
         for j in range(chunk, stop):
-            left = _any_cell(prev[j], prev[j + 1], left, costs[j], penalty)
+            left = cell_value(prev[j], prev[j + 1], left, costs[j], penalty)
             cur[j + 1] = left
             if left > bound:
                 return first, last, j
@@ -78,27 +78,6 @@ def _pruned_row(x, y, i, prev, cur, costs, lo, hi, reach, bound, segments, squar
                 first = j
             last = j
     return first, last, hi - 1
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _any_cell(diagonal, up, left, cost, penalty):
-    """:func:`~._kernels._cell`, or :func:`~._kernels._amerced_cell` with a penalty, of
-    the cells above-left, above and left given as numbers (an array passed to an inlined
-    function is reference-counted at every cell: several times the recursion's cost)."""
-    best = diagonal
-    if penalty == 0.0:
-        if up < best:
-            best = up
-        if left < best:
-            best = left
-        return cost + best
-    step = up + penalty
-    if step < best:
-        best = step
-    step = left + penalty
-    if step < best:
-        best = step
-    return cost + best
 
 
 @njit(cache=True, nogil=True)
@@ -214,7 +193,7 @@ def _univariate_kernel(squared: bool, root: bool, amerced: bool):
             j = s1
             while j < e1:  # row i alone, until row i + 1 can start one column behind
                 cost = univariate_cost(abs(a - y[j, 0]), squared, root)
-                left1 = _any_cell(above[j], above[j + 1], left1, cost, step)
+                left1 = cell_value(above[j], above[j + 1], left1, cost, step)
                 first_row[j + 1] = left1
                 written1 = j
                 j += 1
@@ -231,11 +210,11 @@ def _univariate_kernel(squared: bool, root: bool, amerced: bool):
                     break
             while j < e1:  # both rows: row i at column j, row i + 1 at column j - 1
                 cost = univariate_cost(abs(a - y[j, 0]), squared, root)
-                left1 = _any_cell(above[j], above[j + 1], left1, cost, step)
+                left1 = cell_value(above[j], above[j + 1], left1, cost, step)
                 first_row[j + 1] = left1
                 c = j - 1
                 cost = univariate_cost(abs(b - y[c, 0]), squared, root)
-                left2 = _any_cell(first_row[c], first_row[j], left2, cost, step)
+                left2 = cell_value(first_row[c], first_row[j], left2, cost, step)
                 second_row[j] = left2
                 if left2 <= bound:
                     if first2 < 0:
@@ -259,7 +238,7 @@ def _univariate_kernel(squared: bool, root: bool, amerced: bool):
             e2, reach2 = hi[i + 1], last1 + 1
             while c2 < e2:  # row i + 1 alone, past where row i ended
                 cost = univariate_cost(abs(b - y[c2, 0]), squared, root)
-                left2 = _any_cell(first_row[c2], first_row[c2 + 1], left2, cost, step)
+                left2 = cell_value(first_row[c2], first_row[c2 + 1], left2, cost, step)
                 second_row[c2 + 1] = left2
                 written2 = c2
                 if left2 <= bound:
