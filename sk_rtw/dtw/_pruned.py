@@ -137,10 +137,23 @@ def pruned_distance(x, y, segments, squared, window, bound, penalty=0.0, root=Fa
     exact when at most ``bound``, otherwise some value above it (``inf`` if the bound
     was too low). ``penalty``: amerced DTW's, on every step off the diagonal (0: DTW);
     ``root``: point costs are the square roots of the distances."""
+    lo, hi = sakoe_chiba_rows(x.shape[0], y.shape[0], window)
+    rows = np.empty((3, y.shape[0] + 1))
+    return banded_distance(x, y, segments, squared, lo, hi, bound, penalty, root, rows)
+
+
+@njit(cache=True, nogil=True)
+def banded_distance(x, y, segments, squared, lo, hi, bound, penalty, root, rows):
+    """:func:`pruned_distance` in the staircase band ``[lo[i], hi[i])`` with the buffer
+    ``rows`` (``(3, n)``, ``n > len(y)``): what a search that computes many pairs of one
+    band keeps from one pair to the next instead of allocating it each time."""
+    ny = y.shape[0]
     if bound == _INF:  # the plain recursion, without the pruning's bookkeeping per row
-        lo, hi = sakoe_chiba_rows(x.shape[0], y.shape[0], window)
-        prev, cur = _two_rows(y.shape[0])
-        costs = np.empty(y.shape[0])
+        prev, cur = rows[0], rows[1]
+        prev[: ny + 1] = _INF
+        prev[0] = 0.0
+        cur[: ny + 1] = _INF
+        costs = rows[2]
         for i in range(x.shape[0]):
             _cost_row(x, y[lo[i] : hi[i]], i, hi[i] - lo[i], segments, squared,
                       costs[lo[i] : hi[i]])  # fmt: skip
@@ -148,10 +161,9 @@ def pruned_distance(x, y, segments, squared, window, bound, penalty=0.0, root=Fa
                 _roots(costs[lo[i] : hi[i]], hi[i] - lo[i])
             _band_row(costs, prev, cur, lo[i], hi[i], penalty)
             prev, cur = cur, prev
-        return prev[y.shape[0]]
-    lo, hi = sakoe_chiba_rows(x.shape[0], y.shape[0], window)
+        return prev[ny]
     if is_univariate(segments):
-        return _pruned_univariate(x, y, squared, lo, hi, bound, penalty, root)
+        return _pruned_univariate(x, y, squared, lo, hi, bound, penalty, root, rows)
     return _pruned_rows(x, y, segments, squared, lo, hi, bound, False, penalty, root)[3]
 
 
@@ -170,13 +182,16 @@ def _univariate_kernel(squared: bool, root: bool, amerced: bool):
     change no kept cell: every kept cell, and the distance when it is at most the bound,
     are those of the plain recursion bit for bit."""
 
-    def distance(x, y, lo, hi, bound, penalty):
+    def distance(x, y, lo, hi, bound, penalty, rows):
         nx, ny = x.shape[0], y.shape[0]
         step = penalty if amerced else 0.0
         # padded rows (column j at j + 1): the row above (row -1: zero at the sentinel),
         # then the two rows computed; the last entry of each that may be finite
-        above, first_row = _two_rows(ny)
-        second_row = np.full(ny + 1, _INF)
+        above, first_row, second_row = rows[0], rows[1], rows[2]
+        above[: ny + 1] = _INF
+        above[0] = 0.0
+        first_row[: ny + 1] = _INF
+        second_row[: ny + 1] = _INF
         above_end, first_end, second_end = 0, 0, 0
         start, reach = 0, 0  # the first kept column of the row above, its last plus one
         i = 0
@@ -276,19 +291,19 @@ _SQ, _SQ_AMERCED, _PLAIN, _PLAIN_AMERCED, _ROOT, _ROOT_AMERCED = _UNIVARIATE
 
 
 @njit(cache=True, nogil=True)
-def _pruned_univariate(x, y, squared, lo, hi, bound, penalty, root):
+def _pruned_univariate(x, y, squared, lo, hi, bound, penalty, root, rows):
     """:func:`pruned_distance` of one Euclidean coordinate (:func:`_univariate_kernel`)."""
     if squared:
         if penalty == 0.0:
-            return _SQ(x, y, lo, hi, bound, penalty)
-        return _SQ_AMERCED(x, y, lo, hi, bound, penalty)
+            return _SQ(x, y, lo, hi, bound, penalty, rows)
+        return _SQ_AMERCED(x, y, lo, hi, bound, penalty, rows)
     if root:
         if penalty == 0.0:
-            return _ROOT(x, y, lo, hi, bound, penalty)
-        return _ROOT_AMERCED(x, y, lo, hi, bound, penalty)
+            return _ROOT(x, y, lo, hi, bound, penalty, rows)
+        return _ROOT_AMERCED(x, y, lo, hi, bound, penalty, rows)
     if penalty == 0.0:
-        return _PLAIN(x, y, lo, hi, bound, penalty)
-    return _PLAIN_AMERCED(x, y, lo, hi, bound, penalty)
+        return _PLAIN(x, y, lo, hi, bound, penalty, rows)
+    return _PLAIN_AMERCED(x, y, lo, hi, bound, penalty, rows)
 
 
 @njit(cache=True, nogil=True)

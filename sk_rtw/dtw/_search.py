@@ -58,6 +58,7 @@ from ..manifolds._point_kernels import box_squared_bound, outside
 from ..utils import SeriesCollection, check_series_collection
 from . import _kernels, _point_costs, _pruned
 from ._dtw import check_warp_penalty, check_window, dtw_pairwise_distance
+from ._kernels import sakoe_chiba_rows
 
 _INF = np.inf
 
@@ -214,12 +215,15 @@ def _nearest_by_class(
         bounds = np.empty(n_r)
         order = np.empty(n_r, dtype=np.int64)
         available = np.zeros(n_classes, dtype=np.bool_)
+        rows = np.empty((3, R.shape[1] + 1))  # the DTW's rows
+        band = np.empty((2, Q.shape[1]), dtype=np.int64)  # its band's rows, while it holds
+        banded = np.array([-2.0, -1.0, -1.0])  # for this window and these lengths
         for q in range(block * n_q // n_blocks, (block + 1) * n_q // n_blocks):
             _search_query(
                 q, Q[q, : lq[q]], R, lr, owners, n_classes, skip_reference, skip_class,
                 limits, every_class, segments, squared, window, penalty, root, by_length,
                 out[q], computed, lower, upper, scratch, narrow_lower, narrow_upper,
-                candidates, bounds, order, available,
+                candidates, bounds, order, available, rows, band, banded,
             )  # fmt: skip
     return out, computed
 
@@ -228,10 +232,12 @@ def _nearest_by_class(
 def _search_query(
     q, x, R, lr, owners, n_classes, skip_reference, skip_class, limits, every_class,
     segments, squared, window, penalty, root, by_length, best, computed, lower, upper,
-    scratch, narrow_lower, narrow_upper, candidates, bounds, order, available,
+    scratch, narrow_lower, narrow_upper, candidates, bounds, order, available, rows, band,
+    banded,
 ):  # fmt: skip
     """:func:`_nearest_by_class` of query ``q`` (``x``) into ``best`` (its row of the
-    distances, ``inf``), with buffers of the caller's."""
+    distances, ``inf``), with buffers of the caller's (``band`` holds the Sakoe-Chiba
+    rows of the window and lengths in ``banded``)."""
     enveloped, enveloped_length = -2.0, -1  # the band and length of that envelope
     available[:] = False
     n = 0
@@ -266,8 +272,8 @@ def _search_query(
             diagonal = _point_costs.diagonal_cost(x, y, segments, squared, root)
             diagonal += penalty * abs(x.shape[0] - y.shape[0])
             cut = min(cut, diagonal * (1.0 + LB_SLACK))
-        band = _amerced_band(x.shape[0], y.shape[0], window, penalty, cut)
-        if band != window and threshold < _INF:
+        width = _amerced_band(x.shape[0], y.shape[0], window, penalty, cut)
+        if width != window and threshold < _INF:
             # the paths that can beat the threshold lie in the narrower band: its
             # LB_Keogh may rule the pair out (the full band's seldom does); the query's
             # envelope in it changes only with the band
@@ -278,11 +284,14 @@ def _search_query(
             bound = lb_keogh(y, narrow_lower, narrow_upper, segments, squared, root)
             if bound * (1.0 - LB_SLACK) > threshold:
                 continue
-        value = _pruned.pruned_distance(x, y, segments, squared, band, cut, penalty, root)
+        lo, hi = _band_rows(x.shape[0], y.shape[0], width, band, banded)
+        value = _pruned.banded_distance(x, y, segments, squared, lo, hi, cut, penalty, root,
+                                        rows)  # fmt: skip
         if value > cut and cut < threshold:  # rounding beat the slack: bound it again
-            band = _amerced_band(x.shape[0], y.shape[0], window, penalty, threshold)
-            value = _pruned.pruned_distance(x, y, segments, squared, band, threshold,
-                                            penalty, root)  # fmt: skip
+            width = _amerced_band(x.shape[0], y.shape[0], window, penalty, threshold)
+            lo, hi = _band_rows(x.shape[0], y.shape[0], width, band, banded)
+            value = _pruned.banded_distance(x, y, segments, squared, lo, hi, threshold,
+                                            penalty, root, rows)  # fmt: skip
         computed[q] += 1
         if value <= threshold and value < best[c]:
             best[c] = value
@@ -299,6 +308,19 @@ def _search_query(
         for k in range(n_classes):
             if best[k] > nearest:
                 best[k] = _INF
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _band_rows(nx, ny, window, band, banded):
+    """The Sakoe-Chiba rows of an ``nx x ny`` pair in ``window``
+    (:func:`~._kernels.sakoe_chiba_rows`), computed again only when the window or the
+    lengths differ from those ``banded`` holds."""
+    if window != banded[0] or nx != banded[1] or ny != banded[2]:
+        lo, hi = sakoe_chiba_rows(nx, ny, window)
+        band[0, :nx] = lo
+        band[1, :nx] = hi
+        banded[0], banded[1], banded[2] = window, nx, ny
+    return band[0, :nx], band[1, :nx]
 
 
 @njit(cache=True, nogil=True)

@@ -364,7 +364,8 @@ class ElasticSplitter(Splitter):
                 rng, members, node.training.collections[measure.representation], measure
             )
             return NearestExemplarSplit(measure, present, sources, means=means)
-        sources = np.array([rng.choice(m) for m in members], dtype=np.int64)
+        # one uniform draw per class (``rng.choice(m)``'s draw, a quarter of its time)
+        sources = np.array([m[rng.integers(len(m))] for m in members], dtype=np.int64)
         store = node.stores[measure.representation]
         store.keep(sources)
         return NearestExemplarSplit(measure, present, sources, store=store)
