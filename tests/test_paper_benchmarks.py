@@ -222,7 +222,8 @@ def test_the_scale_benchmark_fixes_the_band_of_its_rows_when_asked(monkeypatch, 
 
 
 def test_the_spd_speed_benchmark_prints_each_manifold_against_r3(capsys):
-    """benchmarks/spd_speed.py's DTW section: one row per manifold, R^3 the 1.0x row."""
+    """benchmarks/spd_speed.py's DTW section: one row per manifold with the time a cell,
+    R^3 the 1.0x row."""
     import numba
     import torch
 
@@ -233,9 +234,10 @@ def test_the_spd_speed_benchmark_prints_each_manifold_against_r3(capsys):
     assert (torch.get_num_threads(), numba.get_num_threads()) == threads  # put back
     rows = [line for line in capsys.readouterr().out.splitlines() if "x R^3" in line]
     assert [row.split(":")[0].strip() for row in rows] == [
-        "Euclidean(dim=3)", "SPD(dim=2)", "SPD(dim=3)", "SPD(dim=8)"
+        "Euclidean(dim=3)", "SPD(dim=2)", "SPD(dim=3)", "SPD(dim=4)", "SPD(dim=8)"
     ]
     assert rows[0].endswith("1.0x R^3")
+    assert all(" ns a cell," in row for row in rows)
 
 
 def test_the_spd_speed_benchmark_counts_eigendecompositions(capsys):
