@@ -309,3 +309,36 @@ def test_the_fingerprint_is_reproducible_and_compares(tmp_path, capsys, monkeypa
     np.savez(second, **arrays)
     assert fingerprint.main(["--compare", str(first), str(second)]) == 1
     assert "different: pw/quat/None/False" in capsys.readouterr().out
+
+
+def test_the_forest_speed_benchmark_records_a_dataset_and_sums_a_half(monkeypatch, tmp_path):
+    """benchmarks/forest_speed.py on a bundled dataset (fewer trees): a record with CPU
+    seconds, 1-NN DTW's time a series, the pickle and memory figures, the two-thread fit;
+    the summary divides the half's totals by 0.6x the published seconds."""
+    import functools
+
+    from benchmarks import forest_speed
+    from sk_rtw import RTWProximityForest
+
+    few_trees = functools.partial(RTWProximityForest, n_trees=3)
+    monkeypatch.setattr(forest_speed, "RTWProximityForest", few_trees)
+    args = forest_speed.main.__globals__["halves_parser"]("t", out_required=False).parse_args(
+        ["--data-dir", str(tmp_path), "--halves", "B"]
+    )
+    args.dtw_series, args.parallel, args.pf2_factor = 4, True, 0.6
+    record = forest_speed.measure("ItalyPowerDemand", 0, None, args)
+    assert record["n_train"] == 67 and record["n_test"] == 1029
+    assert 0.5 < record["accuracy"] <= 1.0
+    for key in ("fit_cpu", "predict_cpu", "dtw_per_series", "fit_wall_1", "fit_wall_2"):
+        assert record[key] > 0
+    assert record["pickle_bytes"] > record["train_bytes"] > 0
+    published = tmp_path / "published_results.csv"
+    published.write_text("dataset,half,PF2_split0,PF2_train_s,PF2_test_s\n"
+                         "ItalyPowerDemand,B,0.9679,0.5,2.0\n")  # fmt: skip
+    args.published = published
+    lines = forest_speed.summary([record], args)
+    row = next(line for line in lines if line.startswith("| B | 0 | 1 |"))
+    cells = [cell.strip() for cell in row.strip("|").split("|")]
+    assert cells[4] == "0.3" and cells[5] == f"{record['fit_cpu'] / 0.3:.2f}x"
+    assert cells[7] == "1.2" and cells[8] == f"{record['predict_cpu'] / 1.2:.2f}x"
+    assert any("n_jobs=2 against n_jobs=1" in line for line in lines)
