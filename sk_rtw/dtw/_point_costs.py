@@ -98,8 +98,8 @@ def _cost_row(x, y, i, ny, segments, squared, row):
     """Row ``i`` of the cost matrix: point costs between ``x[i]`` and ``y[:ny]``."""
     xi = x[i]
     n_segments = segments.shape[0]
-    if n_segments == 1 and segments[0, 2] == FLAT and segments[0, 1] == 1:
-        a = xi[0]  # univariate: |a - b| exactly, at any magnitude
+    if is_univariate(segments):
+        a = xi[0]  # |a - b| exactly, at any magnitude
         for j in range(ny):
             diff = abs(a - y[j, 0])
             row[j] = diff * diff if squared else diff

@@ -41,9 +41,9 @@ def _pruned_row(x, y, i, prev, cur, costs, lo, hi, reach, bound, segments, squar
     kept column of the row above plus one: before it every cell is computed; from it on
     the cells above and above-left exceed the bound, so the first cell there that exceeds
     it ends the row (every cell to its right would too). Returns the first and last kept
-    columns (-1 if none) and the last column written. Point costs are computed for the
-    columns before ``reach`` at once, then :data:`PRUNE_CHUNK` columns at a time (a row
-    that stops early wastes at most that many).
+    columns (-1 if none) and the last column written. Point costs are computed
+    :data:`PRUNE_CHUNK` columns at a time (a row that stops early wastes at most that
+    many).
     """
     if bound == _INF:  # nothing to skip: the plain recursion
         _cost_row(x, y[lo:hi], i, hi - lo, segments, squared, costs[lo:hi])
@@ -53,18 +53,7 @@ def _pruned_row(x, y, i, prev, cur, costs, lo, hi, reach, bound, segments, squar
         return lo, hi - 1, hi - 1
     left = _INF
     first, last = -1, -1
-    inner = min(max(reach, lo), hi)  # columns before it cannot end the row
-    _cost_row(x, y[lo:inner], i, inner - lo, segments, squared, costs[lo:inner])
-    if root:
-        _roots(costs[lo:inner], inner - lo)
-    for j in range(lo, inner):
-        left = cell_value(prev[j], prev[j + 1], left, costs[j], penalty)
-        cur[j + 1] = left
-        if left <= bound:
-            if first < 0:
-                first = j
-            last = j
-    for chunk in range(inner, hi, PRUNE_CHUNK):
+    for chunk in range(lo, hi, PRUNE_CHUNK):
         stop = min(hi, chunk + PRUNE_CHUNK)
         _cost_row(x, y[chunk:stop], i, stop - chunk, segments, squared, costs[chunk:stop])
         if root:
@@ -72,11 +61,12 @@ def _pruned_row(x, y, i, prev, cur, costs, lo, hi, reach, bound, segments, squar
         for j in range(chunk, stop):
             left = cell_value(prev[j], prev[j + 1], left, costs[j], penalty)
             cur[j + 1] = left
-            if left > bound:
+            if left <= bound:
+                if first < 0:
+                    first = j
+                last = j
+            elif j >= reach:
                 return first, last, j
-            if first < 0:
-                first = j
-            last = j
     return first, last, hi - 1
 
 
@@ -176,7 +166,8 @@ def _univariate_kernel(squared: bool, root: bool, amerced: bool):
     Rows go in pairs: row ``i`` as :func:`_pruned_row` computes it (its phases, its end
     at the first cell past ``reach`` above the bound), row ``i + 1`` one column behind
     it in the same loop from row ``i``'s first kept cell on (two chains of dependent
-    additions side by side: 1.6x the cells a second of one row at a time), then alone
+    additions side by side: a bounded 637 x 637 pair in 275 us against 370 us one row at
+    a time), then alone
     past where row ``i`` ended, in its own phases. Cells row ``i + 1`` computes beside
     row ``i`` beyond where a row alone would have stopped are above the bound and
     change no kept cell: every kept cell, and the distance when it is at most the bound,
