@@ -397,3 +397,34 @@ def test_bounded_univariate_distance_is_the_recursions_within_its_bound(rng):
                 assert got == exact, (case, bound)
             else:
                 assert got > bound, (case, bound)
+
+
+@pytest.mark.parametrize(("squared", "root", "exponent"),
+                         [(True, False, 2.0), (False, False, 1.0), (False, True, 0.5)])
+def test_diagonal_cost_pairs_every_step_of_the_longer_series(rng, squared, root, exponent):
+    """The diagonal (upper) bound pairs step ``t`` of the longer series with sample
+    ``floor(t n / m)`` of the shorter, summed in the recursion's order: bit for bit the
+    multivariate path's value (the univariate path computes it without a division per
+    step), and a path's cost that bounds DTW from above."""
+    from sk_rtw.dtw import _point_costs, _pruned
+    from sk_rtw.manifolds import Euclidean
+
+    univariate = _point_costs.segment_codes(Euclidean(1))
+    generic = _point_costs.segment_codes(Euclidean(2))
+    for nx, ny in [(7, 7), (5, 9), (9, 5), (1, 6), (6, 1), (13, 4), (4, 6), (9, 6), (8, 20)]:
+        x, y = np.cumsum(rng.normal(size=nx)), np.cumsum(rng.normal(size=ny))
+        steps = max(nx, ny)
+        t = np.arange(steps)
+        expected = 0.0
+        for gap in np.abs(x[t * nx // steps] - y[t * ny // steps]):
+            expected = gap**exponent + expected
+        got = _point_costs.diagonal_cost(x[:, None], y[:, None], univariate, squared, root)
+        assert got == pytest.approx(expected, rel=1e-13)
+        # the same pairs through the generic segments (a zero second coordinate)
+        pad = np.zeros((1, 1))
+        xx = np.hstack([x[:, None], np.repeat(pad, nx, 0)])
+        yy = np.hstack([y[:, None], np.repeat(pad, ny, 0)])
+        assert got == _point_costs.diagonal_cost(xx, yy, generic, squared, root)
+        exact = _pruned.pruned_distance(x[:, None], y[:, None], univariate, squared, -1.0,
+                                        np.inf, 0.0, root)  # fmt: skip
+        assert exact <= got * (1 + 1e-12)
