@@ -391,7 +391,8 @@ def test_bounded_univariate_distance_is_the_recursions_within_its_bound(rng):
             lo, hi = sakoe_chiba_rows(nx, ny, window)
             assert exact == pytest.approx(_plain_recursion(x, y, lo, hi, exponent, penalty),
                                           rel=1e-12, abs=1e-12)  # fmt: skip
-        for bound in (exact * 0.3, exact * 0.9, exact, exact * (1 + 1e-12), exact * 1.5):
+        for bound in (exact * 0.3, exact * 0.9, exact * (1 - 1e-15), exact, exact * (1 + 1e-15),
+                      exact * (1 + 1e-12), exact * 1.5):
             got = _pruned.pruned_distance(X, Y, segments, squared, window, bound, penalty, root)
             if exact <= bound:
                 assert got == exact, (case, bound)
