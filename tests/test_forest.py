@@ -354,3 +354,30 @@ def test_pickled_nodes_and_splits_keep_their_values_and_types():
                                               node.split.exemplars.data)  # fmt: skip
             pairs += list(zip(node.children, copy.children, strict=True))
         np.testing.assert_array_equal(restored.predict_proba(X), forest.predict_proba(X))
+
+
+def test_the_exemplar_draw_is_one_uniform_draw_per_class_in_turn():
+    """The splitter draws every class's exemplar in one call (``rng.integers`` of the class
+    sizes): the same numbers, in the same order, as one draw per class (the forest's
+    results rest on it), each exemplar a series of its class of the node."""
+    for seed in range(200):
+        sizes = np.random.default_rng(seed).integers(1, (3, 40, 5000, 2**33)[seed % 4],
+                                                     size=1 + seed % 25)  # fmt: skip
+        one_call = np.random.default_rng(seed + 1000)
+        in_turn = np.random.default_rng(seed + 1000)
+        assert one_call.integers(sizes).tolist() == [int(in_turn.integers(n)) for n in sizes]
+        assert one_call.random() == in_turn.random()  # the stream goes on the same
+    X, y = three_classes(n_per_class=9)
+    codes = np.unique(y, return_inverse=True)[1]
+    training = TrainingSet.build(check_series_collection(X), ("raw",), codes, 3)
+    splitter = ElasticSplitter().resolved(
+        {"n_candidates": 1, "representation": "raw", "exemplars": "series"})  # fmt: skip
+    indices = np.array([0, 2, 3, 9, 10, 11, 14, 20, 26])
+    members = NodeSeries(training, indices, codes[indices]).members
+    for seed in range(20):
+        split = splitter.draw(NodeSeries(training, indices, codes[indices]),
+                              np.random.default_rng(seed))  # fmt: skip
+        rng = np.random.default_rng(seed)  # the measure's draws, then one per class
+        splitter.draw_measure(NodeSeries(training, indices, codes[indices]), rng)
+        assert split.sources.tolist() == [m[rng.integers(len(m))] for m in members]
+        assert [codes[s] for s in split.sources] == [0, 1, 2]

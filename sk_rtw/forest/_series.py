@@ -57,7 +57,7 @@ class ExemplarStore:
 
     def keep(self, rows: np.ndarray) -> None:
         """Mark training series ``rows`` as held by a split."""
-        self._used.update(int(r) for r in rows)
+        self._used.update(rows.tolist())
 
     @property
     def used(self) -> np.ndarray:
@@ -194,3 +194,19 @@ class NodeSeries:
     def members(self) -> list[np.ndarray]:
         """The training indices of every present class, in :attr:`present`'s order."""
         return [self.indices[self.codes == c] for c in self.present]
+
+    @cached_property
+    def member_series(self) -> np.ndarray:
+        """:attr:`members` end to end (class by class, as :attr:`member_starts` and
+        :attr:`member_counts` delimit them)."""
+        return np.concatenate(self.members).astype(np.int64, copy=False)
+
+    @cached_property
+    def member_counts(self) -> np.ndarray:
+        """The number of training series of every present class."""
+        return np.array([len(m) for m in self.members], dtype=np.int64)
+
+    @cached_property
+    def member_starts(self) -> np.ndarray:
+        """Where every present class begins in :attr:`member_series`."""
+        return np.concatenate(([0], np.cumsum(self.member_counts)[:-1]))
