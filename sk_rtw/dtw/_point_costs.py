@@ -171,8 +171,8 @@ def diagonal_cost(x, y, segments, squared, root=False):
         short, long_ = (x, y) if nx < ny else (y, x)
         n, k, carried = short.shape[0], 0, 0  # k = floor(t n / steps), carried = t n - k steps
         for t in range(steps):
-            gap = abs(short[k, 0] - long_[t, 0]) if nx < ny else abs(long_[t, 0] - short[k, 0])
-            total = univariate_cost(gap, squared, root) + total
+            # |a - b| and |b - a| are the same number: the order of the pair does not matter
+            total = univariate_cost(abs(short[k, 0] - long_[t, 0]), squared, root) + total
             carried += n
             while carried >= steps:
                 carried -= steps

@@ -199,12 +199,12 @@ class NodeSeries:
     def member_series(self) -> np.ndarray:
         """:attr:`members` end to end (class by class, as :attr:`member_starts` and
         :attr:`member_counts` delimit them)."""
-        return np.concatenate(self.members).astype(np.int64, copy=False)
+        return self.indices[np.argsort(self.codes, kind="stable")].astype(np.int64, copy=False)
 
     @cached_property
     def member_counts(self) -> np.ndarray:
         """The number of training series of every present class."""
-        return np.array([len(m) for m in self.members], dtype=np.int64)
+        return np.bincount(self.codes)[self.present]
 
     @cached_property
     def member_starts(self) -> np.ndarray:
