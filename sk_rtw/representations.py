@@ -99,8 +99,10 @@ def tangent_velocity(X: Any, manifold: str | Manifold = "euclidean") -> np.ndarr
     Euclidean data (``np.diff``), the signed angular step on the circle S^1, the ambient
     tangent vector on S^d (d >= 2), the body angular velocity ``2 log(q_t^-1 q_{t+1})`` of
     unit quaternions (its norm the rotation angle, the sign ambiguity resolved), the
-    whitened logarithm ``logm(X_t^-1/2 X_{t+1} X_t^-1/2)`` of SPD matrices in isometric
-    coordinates (its norm the affine-invariant distance), each factor's of a product.
+    whitened logarithm ``logm(X_t^-1/2 X_{t+1} X_t^-1/2)`` of SPD matrices in the
+    eigenbasis of ``X_t`` and isometric coordinates (its norm the affine-invariant
+    distance; the same in any world frame ``R X R^T``, :class:`~sk_rtw.manifolds.SPD`'s
+    ``velocity_frame``), each factor's of a product.
     Velocities are Euclidean: compare them with ``manifold="euclidean"`` (the
     classifiers' ``representation="velocity"`` does so).
 

@@ -262,6 +262,7 @@ ERRORS = [
     ),
     ("Sphere(dim=0)", lambda: Sphere(0), ValueError, "dim"),
     ("SPD(dim=1.5)", lambda: SPD(1.5), ValueError, "dim"),
+    ("an unknown SPD velocity frame", lambda: SPD(2, "body"), ValueError, "velocity_frame"),
     ("empty product", lambda: Product(()), ValueError, "Product"),
     (
         "zero signals to generate",

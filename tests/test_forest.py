@@ -381,3 +381,36 @@ def test_the_exemplar_draw_is_one_uniform_draw_per_class_in_turn():
         splitter.draw_measure(NodeSeries(training, indices, codes[indices]), rng)
         assert split.sources.tolist() == [m[rng.integers(len(m))] for m in members]
         assert [codes[s] for s in split.sources] == [0, 1, 2]
+
+
+@pytest.mark.parametrize("space", ["quaternion", "spd"])
+def test_rlasa_demonstrations_in_their_own_frames_get_the_same_velocity_forest(space):
+    """R-LASA handwriting (8 shapes, leave demonstration 0 out), every demonstration in a
+    world frame of its own (a rotation and sign per quaternion series, a congruence by a
+    rotation per SPD series): the forest on the tangent velocity (body frame; the SPD
+    step in the eigenbasis of each point) predicts the same classes, and fitted on the
+    moved demonstrations it gives the same probabilities. The SPD velocity in world axes
+    does not: its forest changes its predictions."""
+    from benchmarks.manifold_classification import in_own_frames, load
+    from benchmarks.paper._data import data_dir
+
+    try:
+        root = data_dir(None)
+    except FileNotFoundError:
+        pytest.skip("no shared demonstration data")
+    demos, shapes = load(space, root, 25)
+    demos, shapes = demos[::4], shapes[::4]
+    moved = in_own_frames(demos, space, 0)
+    X_train = demos[:, 1:].reshape(-1, *demos.shape[2:])
+    y_train = np.repeat(shapes, 3)
+    forest = RTWProximityForest(space, representation="velocity", n_trees=10, random_state=0)
+    forest.fit(X_train, y_train)
+    assert forest.score(demos[:, 0], shapes) >= 0.75
+    np.testing.assert_array_equal(forest.predict(moved[:, 0]), forest.predict(demos[:, 0]))
+    refit = clone(forest).fit(moved[:, 1:].reshape(-1, *demos.shape[2:]), y_train)
+    np.testing.assert_allclose(refit.predict_proba(moved[:, 0]),
+                               forest.predict_proba(demos[:, 0]), atol=1e-12)  # fmt: skip
+    if space == "spd":
+        world = clone(forest).set_params(manifold=SPD(2, velocity_frame="world"))
+        world.fit(X_train, y_train)
+        assert not np.allclose(world.predict_proba(moved[:, 0]), world.predict_proba(demos[:, 0]))

@@ -86,27 +86,56 @@ def test_sphere_velocity_is_the_ambient_log_and_turns_with_the_sphere(rng):
                                atol=1e-13)  # fmt: skip
 
 
+def _whitened_logarithm(p, x):
+    """``logm(p^-1/2 x p^-1/2)`` by numpy's eigh and scipy's logm."""
+    w, U = np.linalg.eigh(p)
+    whitening = (U / np.sqrt(w)) @ U.T
+    return scipy.linalg.logm(whitening @ x @ whitening).real
+
+
+def _in_signed_eigenbasis(p, logarithm):
+    """The logarithm in ``p``'s eigenbasis, column by column: ascending eigenvalues, each
+    column's sign chosen so that the first row is non-negative (all but the last column
+    for even k) and the basis a rotation."""
+    k = len(p)
+    U = np.linalg.eigh(p)[1]
+    for j in range(1, k):
+        if j == k - 1 and k % 2 == 0:
+            if np.linalg.det(U) < 0:
+                U[:, j] = -U[:, j]
+        elif U[:, 0] @ logarithm @ U[:, j] < 0:
+            U[:, j] = -U[:, j]
+    return U.T @ logarithm @ U
+
+
+@pytest.mark.parametrize("frame", ["eigen", "world"])
 @pytest.mark.parametrize("k", [2, 3, 4])
-def test_spd_velocity_is_the_whitened_logarithm(k):
-    M = SPD(k)
+def test_spd_velocity_is_the_whitened_logarithm_in_its_frame(k, frame):
+    M = SPD(k, velocity_frame=frame)
     X = random_walk(M, 8, k, step=0.5)
     velocity = tangent_velocity(X[None], M)[0]
     assert velocity.shape == (7, k * (k + 1) // 2)
     rows, cols = np.triu_indices(k)
     weight = np.where(rows == cols, 1.0, np.sqrt(2.0))
     for t in range(7):
-        w, U = np.linalg.eigh(X[t])
-        whitening = (U / np.sqrt(w)) @ U.T
-        logarithm = scipy.linalg.logm(whitening @ X[t + 1] @ whitening).real
+        logarithm = _whitened_logarithm(X[t], X[t + 1])
+        if frame == "eigen":
+            logarithm = _in_signed_eigenbasis(X[t], logarithm)
         np.testing.assert_allclose(velocity[t], logarithm[rows, cols] * weight, atol=1e-12)
     np.testing.assert_allclose(np.linalg.norm(velocity, axis=1), M.dist(X[:-1], X[1:]),
                                rtol=1e-12)  # fmt: skip
 
 
-def test_spd_velocity_under_congruence(rng):
+def _rotation(rng, k):
+    Q, _ = np.linalg.qr(rng.standard_normal((k, k)))
+    Q[:, 0] *= np.sign(np.linalg.det(Q))
+    return Q
+
+
+def test_spd_world_velocity_under_congruence(rng):
     """Any congruence A X A^T keeps each step's norm (the affine-invariant distance); a
     scaling keeps the velocity itself; a rotation R turns its matrix to R L R^T."""
-    M = SPD(3)
+    M = SPD(3, velocity_frame="world")
     X = random_walk(M, 10, 7, step=0.5)
     velocity = tangent_velocity(X[None], M)[0]
     A = rng.standard_normal((3, 3)) + 3 * np.eye(3)
@@ -120,6 +149,40 @@ def test_spd_velocity_under_congruence(rng):
         np.eye(3), R @ M.from_coordinates(np.eye(3), velocity) @ R.T
     )  # coordinates at the identity are the plain isometric ones
     np.testing.assert_allclose(turned, expected, atol=1e-12)
+    assert np.abs(turned - velocity).max() > 0.1  # the world frame turns
+
+
+@pytest.mark.parametrize("k", [2, 3, 4, 5])
+def test_spd_eigen_velocity_is_the_same_in_every_world_frame(k, rng):
+    """A series congruent by a rotation (recorded in another world frame) has the same
+    eigenframe velocity; a scaling too; a reflection, only for odd k (where -I turns no
+    matrix), and for k = 2 it flips the sign of the off-diagonal coordinate."""
+    M = SPD(k)
+    X = random_walk(M, 12, 3 + k, step=0.5)
+    velocity = tangent_velocity(X[None], M)[0]
+    for _ in range(3):
+        R = _rotation(rng, k)
+        np.testing.assert_allclose(tangent_velocity((R @ X @ R.T)[None], M)[0], velocity,
+                                   atol=1e-11)  # fmt: skip
+    np.testing.assert_allclose(tangent_velocity((0.01 * X)[None], M)[0], velocity, atol=1e-12)
+    mirror = np.diag(np.r_[-1.0, np.ones(k - 1)])
+    mirrored = tangent_velocity((mirror @ X @ mirror)[None], M)[0]
+    if k % 2:
+        np.testing.assert_allclose(mirrored, velocity, atol=1e-11)
+    elif k == 2:
+        np.testing.assert_allclose(mirrored, velocity * [1.0, -1.0, 1.0], atol=1e-11)
+
+
+def test_spd_eigen_velocity_at_a_diagonal_point_is_the_world_one():
+    """At a diagonal point with ascending entries the eigenbasis is the identity up to
+    the signs the rule fixes: both frames give the same diagonal, the same magnitudes."""
+    p = np.diag([0.5, 1.0, 3.0])
+    x = SPD(3).exp(p, np.array([[0.2, 0.1, -0.3], [0.1, -0.1, 0.05], [-0.3, 0.05, 0.4]]))
+    eigen = SPD(3).velocity(p, x)
+    world = SPD(3, velocity_frame="world").velocity(p, x)
+    np.testing.assert_allclose(np.abs(eigen), np.abs(world), atol=1e-13)
+    np.testing.assert_allclose(eigen[[0, 3, 5]], world[[0, 3, 5]], atol=1e-13)
+    assert eigen[1] >= 0 and eigen[2] >= 0  # the first row made non-negative (k odd)
 
 
 def test_products_concatenate_their_factors_velocities():

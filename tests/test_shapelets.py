@@ -216,12 +216,15 @@ def test_a_sphere_without_normalisation_draws_raw_shapelets_only():
     assert not any(s.normalised for s in transform.shapelets_)
 
 
+@pytest.mark.parametrize("representation", ["raw", "velocity"])
 @pytest.mark.parametrize("space", ["quaternion", "spd"])
-def test_rlasa_demonstrations_in_their_own_frames_classify_the_same(space):
+def test_rlasa_demonstrations_in_their_own_frames_classify_the_same(space, representation):
     """R-LASA handwriting (8 shapes, leave demonstration 0 out), every demonstration in
     a world frame of its own (a rotation and sign per quaternion series, a congruence
-    by a rotation per SPD series): the normalised shapelets' classifier predicts the
-    same classes, and fitted on the moved demonstrations it is the same classifier."""
+    by a rotation per SPD series): the normalised shapelets' classifier, and the
+    classifier of shapelets from the velocity (body frame, eigenbasis; half of them
+    normalised), predict the same classes, and fitted on the moved demonstrations they
+    are the same classifiers."""
     from benchmarks.manifold_classification import in_own_frames, load
     from benchmarks.paper._data import data_dir
 
@@ -234,8 +237,9 @@ def test_rlasa_demonstrations_in_their_own_frames_classify_the_same(space):
     moved = in_own_frames(demos, space, 0)
     X_train = demos[:, 1:].reshape(-1, *demos.shape[2:])
     y_train = np.repeat(shapes, 3)
-    clf = GeodesicShapeletClassifier(space, n_shapelets=300, normalised_fraction=1.0,
-                                     representation="raw", random_state=0)  # fmt: skip
+    fraction = 1.0 if representation == "raw" else 0.5
+    clf = GeodesicShapeletClassifier(space, n_shapelets=300, normalised_fraction=fraction,
+                                     representation=representation, random_state=0)  # fmt: skip
     clf.fit(X_train, y_train)
     assert clf.score(demos[:, 0], shapes) >= 0.75
     np.testing.assert_array_equal(clf.predict(moved[:, 0]), clf.predict(demos[:, 0]))

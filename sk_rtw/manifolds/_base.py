@@ -335,8 +335,12 @@ class Manifold(ABC):
         * unit quaternions: the body angular velocity ``2 log(p^-1 x)`` in R^3 (the
           rotation vector of the relative rotation, sign ambiguity resolved: its norm is
           the rotation angle, twice :meth:`dist`);
-        * SPD(k): ``logm(p^-1/2 x p^-1/2)`` in isometric coordinates (diagonal and
-          sqrt(2) x upper triangle, ``k (k + 1) / 2`` numbers; norm = :meth:`dist`);
+        * SPD(k): ``logm(p^-1/2 x p^-1/2)`` in the eigenbasis of ``p`` (eigenvalues
+          ascending; ``det = +1``; for k >= 3 the first row's entries made non-negative,
+          the last column's sign from the determinant for even k), in isometric
+          coordinates (diagonal and sqrt(2) x upper triangle, ``k (k + 1) / 2`` numbers;
+          norm = :meth:`dist`): the same for a series in any world frame ``R x R^T``.
+          ``SPD(k, velocity_frame="world")`` keeps the ambient axes;
         * products: each factor's, concatenated;
         * a space of your own: the ambient :meth:`log`, flattened, unless it defines
           ``_velocity`` and :attr:`velocity_dim`.

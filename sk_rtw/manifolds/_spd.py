@@ -19,6 +19,9 @@ from ._symmetric import distinct, eigenvalues, sym, symmetric_function, symmetri
 #: keeps the smallest eigenvalue to about ``MAX_CONDITION * 2.2e-16`` relative accuracy).
 MAX_CONDITION = 1e13
 
+#: The axes a step's whitened logarithm is given in (:attr:`SPD.velocity_frame`).
+VELOCITY_FRAMES = ("eigen", "world")
+
 
 @dataclass(frozen=True)
 class SPD(Manifold):
@@ -39,13 +42,32 @@ class SPD(Manifold):
     ----------
     dim : int, default=2
         Matrix size ``k``; points have shape ``(k, k)``.
+    velocity_frame : {"eigen", "world"}, default="eigen"
+        The axes of :meth:`velocity` (a series' tangent velocity). ``"eigen"``: the
+        step's whitened logarithm ``logm(P^-½ X P^-½)`` in the eigenbasis of ``P``
+        (eigenvalues ascending), the SPD form of a body frame: a congruence of the whole
+        series by a rotation ``R X R^T`` (a demonstration recorded in another world
+        frame) leaves it unchanged. ``"world"``: the same matrix in the ambient axes,
+        turned by ``R`` with the series. Both keep :meth:`dist` as the norm. See
+        :meth:`velocity` for how the eigenvectors' signs are fixed.
     """
 
     dim: int = 2
+    velocity_frame: str = "eigen"
     name = "spd"
 
     def __post_init__(self):
         _check_dim(self.dim, "SPD", minimum=1)
+        if self.velocity_frame not in VELOCITY_FRAMES:
+            raise ValueError(
+                f"velocity_frame must be one of {VELOCITY_FRAMES}, got {self.velocity_frame!r}"
+            )
+
+    def __repr__(self) -> str:
+        # the default frame left out, as scikit-learn prints estimators
+        if self.velocity_frame == "eigen":
+            return f"SPD(dim={self.dim!r})"
+        return f"SPD(dim={self.dim!r}, velocity_frame={self.velocity_frame!r})"
 
     @property
     def point_shape(self) -> tuple[int, ...]:
@@ -81,6 +103,8 @@ class SPD(Manifold):
             ) + shift * eye
             exact = torch.diag_embed(_log_entries(x) - _log_entries(p))
             w = torch.where(diagonal, exact, rescaled)
+        if self.velocity_frame == "eigen":
+            w = _in_eigenbasis(p, w)
         rows, cols, weight = self._triangle(w)
         return w[..., rows, cols] * weight
 
@@ -370,6 +394,27 @@ def _congruence(L: torch.Tensor, X: torch.Tensor) -> torch.Tensor:
     """``L^-1 X L^-T`` (``L`` lower triangular, ``X`` symmetric) by two triangular solves."""
     half = torch.linalg.solve_triangular(L, X, upper=False)  # L^-1 X
     return sym(torch.linalg.solve_triangular(L, half.mT, upper=False))
+
+
+def _in_eigenbasis(p: torch.Tensor, w: torch.Tensor) -> torch.Tensor:
+    """``U^T W U`` for ``P = U diag(lambda) U^T``, eigenvalues ascending, the columns'
+    signs fixed so that a rotation ``R`` of the pair (``R P R^T``, ``R W R^T``: the
+    eigenbasis ``R U``) gives the same matrix: ``det U = +1``, and for ``k >= 3`` the
+    first row's entries ``[0, j]`` non-negative (every ``j >= 1`` for odd ``k``, where
+    ``-I`` is a rotation that turns no matrix; all but the last for even ``k``, whose
+    sign ``det U = +1`` then fixes). ``P`` is eigendecomposed at its power-of-two scale
+    (its eigenvectors are those of ``P``)."""
+    p, w = torch.broadcast_tensors(p, w)
+    basis = torch.linalg.eigh(sym(_unscaled(p, _scale_exponent(p))))[1]
+    w = sym(basis.mT @ w @ basis)
+    k = w.shape[-1]
+    if k == 1:
+        return w
+    signs = torch.where(w[..., 0, :] < 0, -1.0, 1.0).to(w.dtype)
+    signs[..., 0] = 1.0
+    if k % 2 == 0:  # the last column's sign makes det(U S) = +1
+        signs[..., -1] = torch.linalg.det(basis).sign() * signs[..., 1:-1].prod(-1)
+    return w * signs[..., :, None] * signs[..., None, :]
 
 
 def _scale_exponent(p: torch.Tensor) -> torch.Tensor:
