@@ -104,6 +104,28 @@ def test_unequal_lengths_and_thresholds_from_the_class():
         "shapelet0_min", "shapelet0_argmin", "shapelet0_count"]  # fmt: skip
 
 
+@pytest.mark.parametrize("seed", range(4))
+def test_thresholds_are_numpys_nan_percentiles_of_the_valid_windows(seed):
+    """Rows of distances with NaN past each row's valid windows: the percentiles taken
+    rows of one length at once are numpy's nanpercentile, bit for bit (ties, scales,
+    every row valid, one valid window)."""
+    from sk_rtw.shapelets._shapelet import _row_percentiles
+
+    rng = np.random.default_rng(seed)
+    for _ in range(40):
+        n, width = int(rng.integers(1, 25)), int(rng.integers(1, 120))
+        distances = rng.standard_normal((n, width)) * rng.choice([1e-4, 1.0, 1e6])
+        if seed % 2:
+            distances = np.round(distances, 1)  # ties
+        valid = rng.integers(1, width + 1, size=n) if seed < 2 else np.full(n, width)
+        distances[np.arange(width)[None, :] >= valid[:, None]] = np.nan
+        percentiles = (5.0, 10.0) if seed < 3 else tuple(np.sort(rng.uniform(0, 100, 2)))
+        np.testing.assert_array_equal(
+            _row_percentiles(distances, valid, percentiles),
+            np.nanpercentile(distances, percentiles, axis=1),
+        )
+
+
 def _rotated_quaternions(Q, seed):
     rng = np.random.default_rng(seed)
     out = []

@@ -166,9 +166,23 @@ def _group(collection, length, dilation, normalised, series, start, other, unifo
         distances = np.empty((len(series), windows.data.shape[1]))
         window_profiles(windows.data, windows.counts, rows.astype(np.int64),
                         np.ascontiguousarray(form), windows.segments, distances)  # fmt: skip
-    low, high = np.nanpercentile(distances, percentiles, axis=1)
+    valid = windows.counts[rows]
+    low, high = _row_percentiles(distances, valid, percentiles)
     thresholds = low + uniform * (high - low)
     return list(zip(points, thresholds.tolist(), strict=True))
+
+
+def _row_percentiles(
+    distances: np.ndarray, valid: np.ndarray, percentiles: tuple[float, float]
+) -> np.ndarray:
+    """``np.nanpercentile(distances, percentiles, axis=1)`` for rows whose first
+    ``valid[j]`` entries are numbers and the rest NaN: rows of one length at once
+    (``nanpercentile`` along an axis takes one row at a time, in Python)."""
+    out = np.empty((len(percentiles), len(distances)))
+    for count in np.unique(valid):
+        chosen = np.flatnonzero(valid == count)
+        out[:, chosen] = np.percentile(distances[chosen, :count], percentiles, axis=1)
+    return out
 
 
 @dataclass(frozen=True, eq=False)
