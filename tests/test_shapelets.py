@@ -85,6 +85,20 @@ def test_features_are_the_brute_force_ones(manifold):
     np.testing.assert_allclose(got, expected, rtol=1e-9, atol=1e-9)
 
 
+@pytest.mark.parametrize("lengths", [(7, 8, 9), (11, 16, 17), (24, 31)])
+def test_univariate_features_over_blocks_of_terms_are_the_brute_force_ones(lengths):
+    """On R^1 the kernel checks its abandoning every eight terms: shapelets of lengths
+    below, at and past multiples of eight give the brute-force features."""
+    X = np.stack([random_walk(Euclidean(1), 80, s, step=0.3) for s in range(8)])[..., 0]
+    y = [0, 1] * 4
+    transform = GeodesicShapeletTransform(n_shapelets=40, lengths=lengths,
+                                          random_state=1).fit(X, y)  # fmt: skip
+    assert {s.length for s in transform.shapelets_} == set(lengths)
+    np.testing.assert_allclose(transform.transform(X[:4]),
+                               _brute_features(transform, X[:4, :, None], Euclidean(1)),
+                               rtol=1e-12, atol=1e-12)  # fmt: skip
+
+
 def test_unequal_lengths_and_thresholds_from_the_class():
     rng = np.random.default_rng(1)
     X = [rng.standard_normal(n) for n in (30, 41, 35, 50, 33, 44)]
