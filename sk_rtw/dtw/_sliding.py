@@ -55,7 +55,7 @@ def _window_sum(shapelet, window, segments, flat, row, cutoff):
     length, q = shapelet.shape
     total = 0.0
     if flat and q == 1:
-        # four terms between checks (the same additions in the same order: a sum past
+        # eight terms between checks (the same additions in the same order: a sum past
         # the cutoff stays past it, and only sums under it are read)
         k = 0
         while k + 8 <= length:
