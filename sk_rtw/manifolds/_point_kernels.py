@@ -30,6 +30,8 @@ module and a branch in the three functions below; a manifold without a kernel ki
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 import math
 from typing import Any
 
@@ -67,9 +69,23 @@ def _spd_size(code):
     return code - SPD2 + 2
 
 
-def _layout(manifold: Manifold) -> list[tuple[int, int, int, int, int]] | None:
+def _layout(manifold: Manifold) -> tuple[tuple[int, int, int, int, int], ...] | None:
     """Every segment as ``(start, stop, kernel start, kernel stop, code)``: where it lies
-    in the flat point and in its kernel form; None if one has no kernel distance."""
+    in the flat point and in its kernel form; None if one has no kernel distance. Kept
+    per value for frozen dataclasses (the library's manifolds: immutable, compared by
+    value), worked out at every call for any other manifold."""
+    params = getattr(manifold, "__dataclass_params__", None)
+    if dataclasses.is_dataclass(manifold) and params is not None and params.frozen:
+        return _kept_layout(manifold)
+    return _work_out_layout(manifold)
+
+
+@functools.lru_cache(maxsize=128)
+def _kept_layout(manifold: Manifold) -> tuple[tuple[int, int, int, int, int], ...] | None:
+    return _work_out_layout(manifold)
+
+
+def _work_out_layout(manifold: Manifold) -> tuple[tuple[int, int, int, int, int], ...] | None:
     segments = manifold.distance_segments
     if segments is None:
         return None
@@ -85,7 +101,7 @@ def _layout(manifold: Manifold) -> list[tuple[int, int, int, int, int]] | None:
             return None
         rows.append((start, stop, offset, offset + width, code))
         offset += width
-    return rows
+    return tuple(rows)
 
 
 def _check_tiling(manifold: Manifold, segments: Any) -> None:

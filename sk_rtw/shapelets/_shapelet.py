@@ -108,6 +108,8 @@ def draw_shapelets(
         collection = collections[name]
         lengths_r = collection.lengths
         mine = np.flatnonzero(rep == r)
+        if len(mine) == 0:  # every draw is made: nothing of this representation to take
+            continue
         shortest = int(lengths_r[pool].min())
         upper = np.log2(np.maximum(shortest - 1, 1) / np.maximum(length[mine] - 1, 1))
         spread = (2.0 ** (u_dilation[mine] * upper)).astype(np.int64)
@@ -116,10 +118,13 @@ def draw_shapelets(
         start = np.minimum((u_start[mine] * starts).astype(np.int64), starts - 1)
         normal = wants_normal[mine] & (collection.manifold.normalised_space is not None)
         other = _others(series[mine], u_other[mine], pool, codes)
-        keys = np.stack([length[mine], dilation, normal.astype(np.int64)], axis=1)
-        for key in np.unique(keys, axis=0):
-            group = np.flatnonzero((keys == key).all(axis=1))
-            size, d, is_normal = int(key[0]), int(key[1]), bool(key[2])
+        # one window kind per (length, dilation, normalised), taken in that order
+        kinds = (length[mine] * (int(dilation.max()) + 1) + dilation) * 2 + normal
+        for kind in np.unique(kinds):
+            group = np.flatnonzero(kinds == kind)
+            first = group[0]
+            size, d = int(length[mine][first]), int(dilation[first])
+            is_normal = bool(normal[first])
             drawn = _group(collection, size, d, is_normal, series[mine][group],
                            start[group], other[group], u_threshold[mine][group],
                            percentiles)  # fmt: skip
@@ -178,6 +183,8 @@ def _row_percentiles(
     """``np.nanpercentile(distances, percentiles, axis=1)`` for rows whose first
     ``valid[j]`` entries are numbers and the rest NaN: rows of one length at once
     (``nanpercentile`` along an axis takes one row at a time, in Python)."""
+    if len(valid) and valid.min() == valid.max():  # rows of one length: one call
+        return np.percentile(distances[:, : valid[0]], percentiles, axis=1)
     out = np.empty((len(percentiles), len(distances)))
     for count in np.unique(valid):
         chosen = np.flatnonzero(valid == count)
