@@ -96,3 +96,24 @@ def test_align_and_an_estimator_take_it_by_name(registered):
     clf = RTWNearestCentroid(manifold=registered, method="dba", random_state=0).fit(data, y)
     assert clf.manifold_ == CircleAngle()
     assert clf.score(data, y) == 1.0
+
+
+def test_the_kernel_layout_is_kept_only_for_frozen_dataclass_manifolds():
+    """The library's manifolds (frozen dataclasses) keep their kernel layout per value;
+    a subclass that is not itself a frozen dataclass has it worked out at every call,
+    so a change of its segments is seen."""
+    from sk_rtw.manifolds import SPD, Euclidean
+    from sk_rtw.manifolds._point_kernels import _layout
+
+    assert _layout(SPD(3)) is _layout(SPD(3))
+
+    class Settable(Euclidean):
+        @property
+        def distance_segments(self):
+            return self.segments
+
+    space = Settable(2)
+    object.__setattr__(space, "segments", ((0, 2, "euclidean"),))
+    assert _layout(space) == ((0, 2, 0, 2, 0),)
+    object.__setattr__(space, "segments", None)
+    assert _layout(space) is None

@@ -30,7 +30,6 @@ module and a branch in the three functions below; a manifold without a kernel ki
 
 from __future__ import annotations
 
-import dataclasses
 import functools
 import math
 from typing import Any
@@ -72,10 +71,11 @@ def _spd_size(code):
 def _layout(manifold: Manifold) -> tuple[tuple[int, int, int, int, int], ...] | None:
     """Every segment as ``(start, stop, kernel start, kernel stop, code)``: where it lies
     in the flat point and in its kernel form; None if one has no kernel distance. Kept
-    per value for frozen dataclasses (the library's manifolds: immutable, compared by
-    value), worked out at every call for any other manifold."""
-    params = getattr(manifold, "__dataclass_params__", None)
-    if dataclasses.is_dataclass(manifold) and params is not None and params.frozen:
+    per value for instances of a frozen dataclass (the library's manifolds: immutable,
+    compared by value; a subclass that is not itself one does not qualify), worked out
+    at every call for any other manifold."""
+    params = type(manifold).__dict__.get("__dataclass_params__")
+    if params is not None and params.frozen:
         return _kept_layout(manifold)
     return _work_out_layout(manifold)
 
