@@ -401,9 +401,9 @@ def _in_eigenbasis(p: torch.Tensor, w: torch.Tensor) -> torch.Tensor:
     signs fixed so that a rotation ``R`` of the pair (``R P R^T``, ``R W R^T``: the
     eigenbasis ``R U``) gives the same matrix: ``det U = +1``, and for ``k >= 3`` the
     first row's entries ``[0, j]`` non-negative (every ``j >= 1`` for odd ``k``, where
-    ``-I`` is a rotation that turns no matrix; all but the last for even ``k``, whose
-    sign ``det U = +1`` then fixes). ``P`` is eigendecomposed at its power-of-two scale
-    (its eigenvectors are those of ``P``)."""
+    the determinant may then be -1: flipping every column, ``-U``, changes no matrix;
+    all but the last for even ``k``, whose sign ``det U = +1`` then fixes). ``P`` is
+    eigendecomposed at its power-of-two scale (its eigenvectors are those of ``P``)."""
     p, w = torch.broadcast_tensors(p, w)
     basis = torch.linalg.eigh(sym(_unscaled(p, _scale_exponent(p))))[1]
     w = sym(basis.mT @ w @ basis)
