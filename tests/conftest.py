@@ -72,3 +72,20 @@ def interpolate(manifold, x, warps, window=10, refinements=0):
     return tangent_sinc_interpolate(
         manifold, data, torch.tensor([len(x)]), w, window, refinements
     )[0].numpy()
+
+
+def rlasa_in_own_frames(space: str, every: int):
+    """R-LASA demonstrations ``(shapes, 4, T, *point)`` of every ``every``-th shape (every
+    25th sample), their shape names, and the same demonstrations each in a world frame
+    of its own (the R-LASA benchmark's ``--frames``, seed 0); the test is skipped
+    without the shared data."""
+    from benchmarks.manifold_classification import in_own_frames, load
+    from benchmarks.paper._data import data_dir
+
+    try:
+        root = data_dir(None)
+    except FileNotFoundError:
+        pytest.skip("no shared demonstration data")
+    demos, shapes = load(space, root, 25)
+    demos, shapes = demos[::every], shapes[::every]
+    return demos, shapes, in_own_frames(demos, space, 0)

@@ -29,6 +29,7 @@ from sk_rtw.manifolds import SPD, Product, Quaternion, Sphere
 from sk_rtw.representations import represent
 from sk_rtw.utils import check_series_collection
 
+from .conftest import rlasa_in_own_frames
 from .test_dtw import random_walk
 from .test_estimators import EXPECTED_FAILURES, two_shape_classes, znorm
 
@@ -391,16 +392,7 @@ def test_rlasa_demonstrations_in_their_own_frames_get_the_same_velocity_forest(s
     step in the eigenbasis of each point) predicts the same classes, and fitted on the
     moved demonstrations it gives the same probabilities. The SPD velocity in world axes
     does not: its forest changes its predictions."""
-    from benchmarks.manifold_classification import in_own_frames, load
-    from benchmarks.paper._data import data_dir
-
-    try:
-        root = data_dir(None)
-    except FileNotFoundError:
-        pytest.skip("no shared demonstration data")
-    demos, shapes = load(space, root, 25)
-    demos, shapes = demos[::4], shapes[::4]
-    moved = in_own_frames(demos, space, 0)
+    demos, shapes, moved = rlasa_in_own_frames(space, every=4)
     X_train = demos[:, 1:].reshape(-1, *demos.shape[2:])
     y_train = np.repeat(shapes, 3)
     forest = RTWProximityForest(space, representation="velocity", n_trees=10, random_state=0)
@@ -433,16 +425,7 @@ def test_the_default_forest_holds_on_rlasa_demonstrations_in_their_own_frames(sp
     """R-LASA (10 shapes, 4 folds), every demonstration in a world frame of its own: the
     default forest (series and velocity drawn) loses at most two test series of 40; with
     the SPD velocity in world axes it falls by more than a fifth (what it did before)."""
-    from benchmarks.manifold_classification import in_own_frames, load
-    from benchmarks.paper._data import data_dir
-
-    try:
-        root = data_dir(None)
-    except FileNotFoundError:
-        pytest.skip("no shared demonstration data")
-    demos, shapes = load(space, root, 25)
-    demos, shapes = demos[::3], shapes[::3]
-    moved = in_own_frames(demos, space, 0)
+    demos, shapes, moved = rlasa_in_own_frames(space, every=3)
     forest = RTWProximityForest(space, n_trees=20, random_state=0)
     same = _rlasa_accuracy(forest, demos, shapes)
     assert same >= 0.9

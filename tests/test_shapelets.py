@@ -14,6 +14,7 @@ from sklearn.utils.estimator_checks import parametrize_with_checks
 from sk_rtw import SPD, GeodesicShapeletClassifier, GeodesicShapeletTransform, Quaternion
 from sk_rtw.manifolds import Euclidean, Product, Sphere, quaternion_product
 
+from .conftest import rlasa_in_own_frames
 from .test_dtw import random_walk
 from .test_estimators import EXPECTED_FAILURES
 
@@ -261,16 +262,7 @@ def test_rlasa_demonstrations_in_their_own_frames_classify_the_same(space, repre
     classifier of shapelets from the velocity (body frame, eigenbasis; half of them
     normalised), predict the same classes, and fitted on the moved demonstrations they
     are the same classifiers."""
-    from benchmarks.manifold_classification import in_own_frames, load
-    from benchmarks.paper._data import data_dir
-
-    try:
-        root = data_dir(None)
-    except FileNotFoundError:
-        pytest.skip("no shared demonstration data")
-    demos, shapes = load(space, root, 25)
-    demos, shapes = demos[::4], shapes[::4]
-    moved = in_own_frames(demos, space, 0)
+    demos, shapes, moved = rlasa_in_own_frames(space, every=4)
     X_train = demos[:, 1:].reshape(-1, *demos.shape[2:])
     y_train = np.repeat(shapes, 3)
     fraction = 1.0 if representation == "raw" else 0.5
