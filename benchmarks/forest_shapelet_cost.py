@@ -29,7 +29,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the repository
 from sk_rtw import ElasticSplitter, RTWProximityForest, ShapeletSplitter
 from sk_rtw.utils import from_aeon
 
-KINDS = {"elastic": None, "shapelets": lambda: [ElasticSplitter(), ShapeletSplitter()]}
+#: The splitters of each forest (None: the default forest's).
+KINDS = {"elastic": lambda: None, "shapelets": lambda: [ElasticSplitter(), ShapeletSplitter()]}
 
 
 def measure(name: str, data_dir: str | None, seed: int) -> dict:
@@ -43,12 +44,10 @@ def measure(name: str, data_dir: str | None, seed: int) -> dict:
     rows = np.concatenate([np.flatnonzero(y == c)[:3] for c in np.unique(y)])
     out = {}
     for splitters in KINDS.values():
-        RTWProximityForest(n_trees=2, random_state=0,
-                           splitters=splitters() if splitters else None).fit(
+        RTWProximityForest(n_trees=2, random_state=0, splitters=splitters()).fit(
             X[rows], y[rows]).predict(X_test[:5])  # fmt: skip
     for kind, splitters in KINDS.items():
-        forest = RTWProximityForest(random_state=seed, n_jobs=1,
-                                    splitters=splitters() if splitters else None)  # fmt: skip
+        forest = RTWProximityForest(random_state=seed, n_jobs=1, splitters=splitters())
         start = time.process_time()
         forest.fit(X, y)
         fit = time.process_time() - start

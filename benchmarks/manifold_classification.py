@@ -247,8 +247,8 @@ def main(argv=None) -> int:
         if args.frames:
             demos = in_own_frames(demos, space, args.seed)
         results[space] = {}
+        manifold = SPD(2, velocity_frame=args.spd_velocity_frame) if space == "spd" else None
         for fold in args.folds:
-            manifold = SPD(2, velocity_frame=args.spd_velocity_frame) if space == "spd" else None
             results[space][fold] = run_fold(
                 space, demos, shapes, fold, args.rows, args.method, args.seed, not args.quiet,
                 manifold,

@@ -183,11 +183,10 @@ def _row_percentiles(
     """``np.nanpercentile(distances, percentiles, axis=1)`` for rows whose first
     ``valid[j]`` entries are numbers and the rest NaN: rows of one length at once
     (``nanpercentile`` along an axis takes one row at a time, in Python)."""
-    if len(valid) and valid.min() == valid.max():  # rows of one length: one call
-        return np.percentile(distances[:, : valid[0]], percentiles, axis=1)
     out = np.empty((len(percentiles), len(distances)))
-    for count in np.unique(valid):
-        chosen = np.flatnonzero(valid == count)
+    lengths = np.unique(valid)
+    for count in lengths:
+        chosen = slice(None) if len(lengths) == 1 else np.flatnonzero(valid == count)
         out[:, chosen] = np.percentile(distances[chosen, :count], percentiles, axis=1)
     return out
 
