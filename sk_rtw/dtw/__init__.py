@@ -14,7 +14,10 @@ midpoints) and :func:`soft_dtw_batch` (soft-DTW values and expected alignments).
 and early abandoning; :func:`prepare_series` puts a collection in the kernels' form once
 for many searches on the calling thread (:func:`nearest_group`, and
 :func:`mean_diagonal_cost`, the scale of amerced DTW's penalty). :func:`window_distances`
-and :func:`shapelet_features` slide a shapelet over windows of series (``_sliding``).
+and :func:`shapelet_features` slide a shapelet over windows of series (``_sliding``);
+:func:`read_window`, :func:`series_window_profile` and :func:`series_window_feature` read
+the windows of Euclidean series in place (z-normalised as numpy does) and
+:func:`linear_percentiles` is numpy's percentile, for one shapelet at a time.
 
 The modules stand on floors, each importing only those below it: the compiled point
 costs (``_point_costs``, rows of costs from the manifolds' point geometry, which is the
@@ -34,7 +37,15 @@ from ._paths import has_compiled_costs, mean_matched_positions, path_indices
 from ._point_costs import kernel_point_form
 from ._prepared import EXPONENTS, PreparedSeries, mean_diagonal_cost, nearest_group, prepare_series
 from ._search import dtw_nearest_distance
-from ._sliding import shapelet_features, window_distances, window_profiles
+from ._sliding import (
+    linear_percentiles,
+    read_window,
+    series_window_feature,
+    series_window_profile,
+    shapelet_features,
+    window_distances,
+    window_profiles,
+)
 from ._soft import soft_dtw_batch
 
 __all__ = [
@@ -49,6 +60,7 @@ __all__ = [
     "dtw_path",
     "has_compiled_costs",
     "kernel_point_form",
+    "linear_percentiles",
     "mean_diagonal_cost",
     "mean_matched_positions",
     "medoid_index",
@@ -58,6 +70,9 @@ __all__ = [
     "path_indices",
     "point_cost_matrix",
     "prepare_series",
+    "read_window",
+    "series_window_feature",
+    "series_window_profile",
     "shapelet_features",
     "soft_dtw_batch",
     "solved_exactly",

@@ -1,8 +1,10 @@
-"""Gini impurity and the gain of a split: what every candidate of a node is scored by."""
+"""Gini impurity and the gain of a split: what every candidate of a node is scored by,
+and the best threshold on one value per series (a shapelet split's)."""
 
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 
 def gini(codes: np.ndarray, n_classes: int) -> float:
@@ -21,3 +23,51 @@ def gini_gain(codes: np.ndarray, branches: np.ndarray, n_branches: int, n_classe
     filled = sizes > 0
     children = sizes[filled] - (table[filled] ** 2).sum(1) / sizes[filled]
     return gini(codes, n_classes) - float(children.sum()) / len(codes)
+
+
+@njit(cache=True, nogil=True)
+def _best_cut(values, codes, n_classes, parent):
+    """The threshold of the largest Gini gain on ``values`` (the first of equal gains)
+    and that gain, ``parent`` the impurity of ``codes``; ``(nan, 0)`` when every value
+    is equal. Class counts are whole numbers, so their sums of squares are exact in any
+    order: the gains are :func:`best_threshold`'s arithmetic, value for value."""
+    n = values.shape[0]
+    order = np.argsort(values, kind="mergesort")
+    counts = np.zeros(n_classes)
+    for i in range(n):
+        counts[codes[i]] += 1.0
+    left = np.zeros(n_classes)
+    left_squares = 0.0
+    right_squares = 0.0
+    for c in range(n_classes):
+        right_squares += counts[c] * counts[c]
+    best_gain, best = -np.inf, -1
+    for i in range(n - 1):
+        c = codes[order[i]]
+        left_squares += 2.0 * left[c] + 1.0
+        left[c] += 1.0
+        right_squares -= 2.0 * (counts[c] - left[c]) + 1.0
+        if values[order[i + 1]] > values[order[i]]:  # a cut after position i
+            n_left = i + 1.0
+            n_right = n - n_left
+            impurity = (n_left - left_squares / n_left) + (n_right - right_squares / n_right)
+            gain = parent - impurity / n
+            if gain > best_gain:
+                best_gain, best = gain, i
+    if best < 0:
+        return np.nan, 0.0
+    return 0.5 * (values[order[best]] + values[order[best + 1]]), best_gain
+
+
+def best_threshold(
+    values: np.ndarray, codes: np.ndarray, n_classes: int, impurity: float | None = None
+) -> tuple[float, float]:
+    """The threshold of the largest Gini gain on ``values`` (a midpoint between two
+    consecutive distinct values; the first of equal gains) and that gain; ``(nan, 0)``
+    when the values are all equal. ``impurity``: :func:`gini` of ``codes``, if known."""
+    if impurity is None:
+        impurity = gini(codes, n_classes)
+    threshold, gain = _best_cut(np.ascontiguousarray(values, dtype=np.float64),
+                                np.asarray(codes, dtype=np.int64), int(n_classes),
+                                float(impurity))  # fmt: skip
+    return float(threshold), float(gain)

@@ -13,6 +13,7 @@ import numpy as np
 from ..dtw import PreparedSeries, prepare_series
 from ..representations import represent
 from ..utils import SeriesCollection
+from ._gini import gini
 
 
 @dataclass(frozen=True, eq=False)
@@ -149,6 +150,11 @@ class SeriesView(Mapping[str, PreparedSeries]):
             ].subset(self.indices)
         return self._collections[representation]
 
+    def source(self, representation: str) -> tuple[SeriesCollection, np.ndarray]:
+        """The whole set's series in ``representation`` (as points) and this view's rows
+        of it: for kernels that read the series in place, nothing taken."""
+        return self._series.collections[representation], self.indices
+
     def __iter__(self):
         return iter(self._series.prepared)
 
@@ -184,6 +190,11 @@ class NodeSeries:
     @property
     def n_classes(self) -> int:
         return self.training.n_classes
+
+    @cached_property
+    def impurity(self) -> float:
+        """The Gini impurity of the node's classes."""
+        return gini(self.codes, self.n_classes)
 
     @cached_property
     def present(self) -> np.ndarray:

@@ -29,13 +29,18 @@ from ..shapelets import (
     Shapelet,
     ShapeletBank,
     default_length,
-    draw_shapelets,
+    draw_site,
+    feature_in_place,
     features,
+    reads_in_place,
+    take_shapelet,
+    take_shapelets,
     window_space,
 )
 from ..utils._constraints import Constant, Interval, InvalidParameterError, Options, Satisfies
 from ..utils._params import Parameter, declare_parameters, validate_parameters
 from ._elastic import REPRESENTATION_OPTIONS
+from ._gini import best_threshold
 from ._series import NodeSeries, SeriesView
 from ._splitter import Splitter
 
@@ -106,12 +111,15 @@ class ShapeletSplit:
     feature : str
         One of ``"min"``, ``"argmin"``, ``"count"``.
     threshold : float
+    bank : ShapeletBank or None
+        The shapelet in the kernels' form; None where its windows are read in place
+        (Euclidean coordinates: :func:`~sk_rtw.shapelets.feature_in_place`).
     """
 
     shapelet: Shapelet
     feature: str
     threshold: float
-    bank: ShapeletBank
+    bank: ShapeletBank | None = None
 
     @property
     def n_branches(self) -> int:
@@ -119,8 +127,11 @@ class ShapeletSplit:
 
     def values(self, series: SeriesView) -> np.ndarray:
         """The shapelet's feature for every series of the view."""
-        collections = {self.shapelet.representation: series.collection(
-            self.shapelet.representation)}  # fmt: skip
+        representation = self.shapelet.representation
+        if self.bank is None:
+            collection, rows = series.source(representation)
+            return feature_in_place(collection, rows, self.shapelet, self.feature)
+        collections = {representation: series.collection(representation)}
         return features(collections, self.bank)[:, 0, FEATURES.index(self.feature)]
 
     def route(self, series: Mapping[str, Any]) -> np.ndarray:
@@ -135,30 +146,6 @@ class ShapeletSplit:
             f"{self.feature} of a {kind}shapelet of {s.length} points at dilation "
             f"{s.dilation} on the {s.representation} series, threshold {self.threshold:.4g}"
         )
-
-
-def best_threshold(values: np.ndarray, codes: np.ndarray, n_classes: int) -> tuple[float, float]:
-    """The threshold of the largest Gini gain on ``values`` (a midpoint between two
-    consecutive distinct values; the first of equal gains) and that gain; ``(nan, 0)``
-    when the values are all equal."""
-    order = np.argsort(values, kind="stable")
-    ordered, labels = values[order], codes[order]
-    n = len(values)
-    cuts = np.flatnonzero(ordered[1:] > ordered[:-1])  # split after position cut
-    if len(cuts) == 0:
-        return float("nan"), 0.0
-    counts = np.bincount(labels, minlength=n_classes)
-    left = np.cumsum(np.eye(n_classes)[labels], axis=0)[cuts]
-    right = counts - left
-    n_left = cuts + 1.0
-    n_right = n - n_left
-    total = counts / n
-    parent = 1.0 - total @ total
-    impurity = (n_left - (left**2).sum(1) / n_left) + (n_right - (right**2).sum(1) / n_right)
-    gains = parent - impurity / n
-    best = int(np.argmax(gains))
-    cut = cuts[best]
-    return float(0.5 * (ordered[cut] + ordered[cut + 1])), float(gains[best])
 
 
 @declare_parameters(SHAPELET_SPLITTER_PARAMETERS, SHAPELET_SPLITTER_DEFAULTS, positional=0)
@@ -240,23 +227,50 @@ class ShapeletSplitter(Splitter):
         return self.lengths
 
     def candidate(self, node: NodeSeries, rng: np.random.Generator):
-        training = node.training
-        (shapelet,) = draw_shapelets(
-            rng, 1, training.collections, training.codes, self.representations,
-            self._lengths(node), self.normalised_fraction, self.threshold_percentiles,
-            candidates=node.indices,
-        )  # fmt: skip
+        shapelet, bank = self._shapelet(node, rng)
         feature = self.features[int(rng.integers(len(self.features)))]
-        space = window_space(training.collections[shapelet.representation].manifold,
-                             shapelet.normalised)  # fmt: skip
-        bank = ShapeletBank.build([shapelet], lambda r, normal: space)
-        split = ShapeletSplit(shapelet, feature, 0.0, bank)
-        values = split.values(node.series)
-        threshold, _ = best_threshold(values, node.codes, node.n_classes)
+        values = ShapeletSplit(shapelet, feature, 0.0, bank).values(node.series)
+        threshold, _ = best_threshold(values, node.codes, node.n_classes, node.impurity)
         if not np.isfinite(threshold):  # every value equal: nothing to split
             threshold = float(values[0]) if len(values) else 0.0
         split = ShapeletSplit(shapelet, feature, threshold, bank)
         return split, (values > threshold).astype(np.int64)
+
+    def _shapelet(self, node: NodeSeries, rng: np.random.Generator) -> tuple[
+        Shapelet, ShapeletBank | None
+    ]:  # fmt: skip
+        """One shapelet drawn from the node's series, and its bank (None where its
+        windows are read in place): :func:`~sk_rtw.shapelets.draw_shapelets` of one."""
+        training = node.training
+        lengths, shortest, classmates = self._pool(node)
+        sites = draw_site(rng, training.collections, training.codes, self.representations,
+                          lengths, self.normalised_fraction, node.indices, shortest,
+                          classmates)  # fmt: skip
+        name = self.representations[int(sites.representation[0])]
+        collection = training.collections[name]
+        if reads_in_place(collection.manifold):
+            shapelet = take_shapelet(collection, name, sites, 0, training.codes,
+                                     self.threshold_percentiles)  # fmt: skip
+            return shapelet, None
+        (shapelet,) = take_shapelets(sites, training.collections, training.codes,
+                                     self.representations, self.threshold_percentiles)  # fmt: skip
+        space = window_space(collection.manifold, shapelet.normalised)
+        return shapelet, ShapeletBank.build([shapelet], lambda r, normal: space)
+
+    def _pool(self, node: NodeSeries) -> tuple[
+        tuple[int, ...], dict[str, int], dict[int, np.ndarray]
+    ]:  # fmt: skip
+        """What every candidate at ``node`` draws from (kept in its memo): the lengths,
+        the shortest series of the node in each representation, its series by class."""
+        key = ("shapelet pool", self.representations, self.lengths)
+        if key not in node.memo:
+            collections = node.training.collections
+            shortest = {name: int(collections[name].lengths[node.indices].min())
+                        for name in self.representations}  # fmt: skip
+            classmates = {int(c): members for c, members in zip(node.present, node.members,
+                                                                  strict=True)}  # fmt: skip
+            node.memo[key] = self._lengths(node), shortest, classmates
+        return node.memo[key]
 
     def draw(self, node: NodeSeries, rng: np.random.Generator) -> ShapeletSplit:
         split, _ = self.candidate(node, rng)

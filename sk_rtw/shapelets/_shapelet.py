@@ -94,46 +94,138 @@ def draw_shapelets(
     threshold uniform between ``percentiles`` of its distances to the windows of another
     series of its class (the series itself where its class has no other).
 
-    Every draw is made up front, then the shapelets of one window kind are taken and
-    thresholded together (one compiled pass over the windows they need)."""
+    Every draw is made up front (:func:`draw_sites`), then the shapelets are taken
+    (:func:`take_shapelets`)."""
+    sites = draw_sites(rng, n_shapelets, collections, codes, representations, lengths,
+                       p_normalised, candidates)  # fmt: skip
+    return take_shapelets(sites, collections, codes, representations, percentiles)
+
+
+def take_shapelets(
+    sites: Sites,
+    collections: Mapping[str, SeriesCollection],
+    codes: np.ndarray,
+    representations: Sequence[str],
+    percentiles: tuple[float, float],
+) -> list[Shapelet]:
+    """The shapelets drawn at ``sites``, their points and thresholds: those of one
+    window kind together (one compiled pass over the windows they need)."""
+    shapelets: list[Shapelet | None] = [None] * len(sites.series)
+    for r, name in enumerate(representations):
+        mine = np.flatnonzero(sites.representation == r)
+        if len(mine) == 0:
+            continue
+        collection = collections[name]
+        length, dilation, normal = sites.length[mine], sites.dilation[mine], sites.normalised[mine]
+        # one window kind per (length, dilation, normalised), taken in that order
+        kinds = (length * (int(dilation.max()) + 1) + dilation) * 2 + normal
+        for kind in np.unique(kinds):
+            group = mine[kinds == kind]
+            first = group[0]
+            size, d = int(sites.length[first]), int(sites.dilation[first])
+            is_normal = bool(sites.normalised[first])
+            drawn = _group(collection, size, d, is_normal, sites.series[group],
+                           sites.start[group], sites.other[group], sites.uniform[group],
+                           percentiles)  # fmt: skip
+            for j, (points, threshold) in zip(group, drawn, strict=True):
+                shapelets[j] = Shapelet(name, is_normal, size, d, points, threshold,
+                                        (int(sites.series[j]), int(sites.start[j])),
+                                        int(codes[sites.series[j]]))  # fmt: skip
+    return [s for s in shapelets if s is not None]
+
+
+@dataclass(frozen=True, eq=False)
+class Sites:
+    """Where ``n`` shapelets are drawn, one entry each: the index of the representation,
+    length, dilation, whether normalised, the series and the first sample, another series
+    of its class and the uniform number that places its threshold between the
+    percentiles."""
+
+    representation: np.ndarray
+    length: np.ndarray
+    dilation: np.ndarray
+    normalised: np.ndarray
+    series: np.ndarray
+    start: np.ndarray
+    other: np.ndarray
+    uniform: np.ndarray
+
+
+def draw_sites(
+    rng: np.random.Generator,
+    n: int,
+    collections: Mapping[str, SeriesCollection],
+    codes: np.ndarray,
+    representations: Sequence[str],
+    lengths: Sequence[int],
+    p_normalised: float,
+    candidates: np.ndarray | None = None,
+) -> Sites:
+    """Every random draw of :func:`draw_shapelets` (made up front, in its order)."""
     pool = np.arange(len(codes)) if candidates is None else np.asarray(candidates)
-    n = n_shapelets
     rep = rng.integers(len(representations), size=n)
     length = np.asarray(lengths, dtype=np.int64)[rng.integers(len(lengths), size=n)]
     wants_normal = rng.uniform(size=n) < p_normalised
     u_dilation, u_series, u_start, u_other, u_threshold = rng.uniform(size=(5, n))
     series = pool[np.minimum((u_series * len(pool)).astype(np.int64), len(pool) - 1)]
-    shapelets: list[Shapelet | None] = [None] * n
+    dilation = np.ones(n, dtype=np.int64)
+    start = np.zeros(n, dtype=np.int64)
+    normal = np.zeros(n, dtype=bool)
+    other = np.zeros(n, dtype=np.int64)
     for r, name in enumerate(representations):
-        collection = collections[name]
-        lengths_r = collection.lengths
         mine = np.flatnonzero(rep == r)
         if len(mine) == 0:  # every draw is made: nothing of this representation to take
             continue
+        collection = collections[name]
+        lengths_r = collection.lengths
         shortest = int(lengths_r[pool].min())
         upper = np.log2(np.maximum(shortest - 1, 1) / np.maximum(length[mine] - 1, 1))
         spread = (2.0 ** (u_dilation[mine] * upper)).astype(np.int64)
-        dilation = np.where(length[mine] < 2, 1, np.maximum(1, spread))
-        starts = lengths_r[series[mine]] - (length[mine] - 1) * dilation
-        start = np.minimum((u_start[mine] * starts).astype(np.int64), starts - 1)
-        normal = wants_normal[mine] & (collection.manifold.normalised_space is not None)
-        other = _others(series[mine], u_other[mine], pool, codes)
-        # one window kind per (length, dilation, normalised), taken in that order
-        kinds = (length[mine] * (int(dilation.max()) + 1) + dilation) * 2 + normal
-        for kind in np.unique(kinds):
-            group = np.flatnonzero(kinds == kind)
-            first = group[0]
-            size, d = int(length[mine][first]), int(dilation[first])
-            is_normal = bool(normal[first])
-            drawn = _group(collection, size, d, is_normal, series[mine][group],
-                           start[group], other[group], u_threshold[mine][group],
-                           percentiles)  # fmt: skip
-            for position, (points, threshold) in zip(group, drawn, strict=True):
-                j = int(mine[position])
-                shapelets[j] = Shapelet(name, is_normal, size, d, points, threshold,
-                                        (int(series[j]), int(start[position])),
-                                        int(codes[series[j]]))  # fmt: skip
-    return [s for s in shapelets if s is not None]
+        dilation[mine] = np.where(length[mine] < 2, 1, np.maximum(1, spread))
+        starts = lengths_r[series[mine]] - (length[mine] - 1) * dilation[mine]
+        start[mine] = np.minimum((u_start[mine] * starts).astype(np.int64), starts - 1)
+        normal[mine] = wants_normal[mine] & (collection.manifold.normalised_space is not None)
+        other[mine] = _others(series[mine], u_other[mine], pool, codes)
+    return Sites(rep, length, dilation, normal, series, start, other, u_threshold)
+
+
+def draw_site(
+    rng: np.random.Generator,
+    collections: Mapping[str, SeriesCollection],
+    codes: np.ndarray,
+    representations: Sequence[str],
+    lengths: Sequence[int],
+    p_normalised: float,
+    pool: np.ndarray,
+    shortest: Mapping[str, int],
+    classmates: Mapping[int, np.ndarray],
+) -> Sites:
+    """:func:`draw_sites` of one shapelet from ``pool`` in scalars, bit for bit (the same
+    draws from ``rng``, numpy's arithmetic on them): what a forest's candidate draws.
+    ``shortest[name]``: the shortest series of ``pool`` in each representation;
+    ``classmates[label]``: the series of ``pool`` of each class, in ``pool``'s order."""
+    r = int(rng.integers(len(representations)))
+    length = int(lengths[int(rng.integers(len(lengths)))])
+    wants_normal = rng.random() < p_normalised
+    u_dilation, u_series, u_start, u_other, u_threshold = rng.random(5)
+    series = int(pool[min(int(u_series * len(pool)), len(pool) - 1)])
+    name = representations[r]
+    collection = collections[name]
+    upper = np.log2(np.float64(max(shortest[name] - 1, 1) / max(length - 1, 1)))
+    spread = int(np.power(2.0, u_dilation * upper))
+    dilation = 1 if length < 2 else max(1, spread)
+    starts = int(collection.lengths[series]) - (length - 1) * dilation
+    start = min(int(u_start * starts), starts - 1)
+    normal = bool(wants_normal) and collection.manifold.normalised_space is not None
+    same = classmates[int(codes[series])]
+    other = series
+    if len(same) >= 2:
+        pick = min(int(u_other * (len(same) - 1)), len(same) - 2)
+        own = int(np.searchsorted(same, series))  # the drawn series, skipped
+        other = int(same[pick + (pick >= own)])
+    return Sites(np.array([r]), np.array([length]), np.array([dilation]), np.array([normal]),
+                 np.array([series]), np.array([start]), np.array([other]),
+                 np.array([u_threshold]))  # fmt: skip
 
 
 def _others(series: np.ndarray, uniform: np.ndarray, pool: np.ndarray, codes: np.ndarray):
