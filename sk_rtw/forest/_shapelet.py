@@ -9,7 +9,10 @@ features for every series of the node (the smallest window distance, where it li
 the occurrences), draws one feature uniformly and splits at the threshold of the largest
 Gini gain (the midpoint between two consecutive distinct values): series at or below it
 go to the first branch. The split holds the shapelet, the feature and the threshold:
-it routes any series by computing that feature.
+it routes any series by computing that feature. On Euclidean coordinates (the raw series
+of R^d, the tangent velocity of any manifold) the shapelet is taken and its feature
+computed by kernels that read the windows in place (:mod:`sk_rtw.shapelets._in_place`:
+the same numbers as the gathered windows, without gathering them).
 """
 
 from __future__ import annotations
