@@ -26,8 +26,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the repository
 
+from benchmarks.ucr._data import load_split, take  # missing values filled as in the UCR run
 from sk_rtw import ElasticSplitter, RTWProximityForest, ShapeletSplitter
-from sk_rtw.utils import from_aeon
 
 #: The splitters of each forest (None: the default forest's).
 KINDS = {"elastic": lambda: None, "shapelets": lambda: [ElasticSplitter(), ShapeletSplitter()]}
@@ -35,17 +35,14 @@ KINDS = {"elastic": lambda: None, "shapelets": lambda: [ElasticSplitter(), Shape
 
 def measure(name: str, data_dir: str | None, seed: int) -> dict:
     """Fit and predict CPU seconds and accuracy of both forests on one dataset."""
-    from aeon.datasets import load_classification
-
-    kw = {"extract_path": data_dir} if data_dir else {}
-    X, y = load_classification(name, split="train", **kw)
-    X_test, y_test = load_classification(name, split="test", **kw)
-    X, X_test = from_aeon(X), from_aeon(X_test)
+    train, test = load_split(name, "train", data_dir), load_split(name, "test", data_dir)
+    X, y, X_test, y_test = train.X, train.y, test.X, test.y
     rows = np.concatenate([np.flatnonzero(y == c)[:3] for c in np.unique(y)])
+    few = take(train, rows)
     out = {}
     for splitters in KINDS.values():
         RTWProximityForest(n_trees=2, random_state=0, splitters=splitters()).fit(
-            X[rows], y[rows]).predict(X_test[:5])  # fmt: skip
+            few.X, few.y).predict(X_test[:5])  # fmt: skip
     for kind, splitters in KINDS.items():
         forest = RTWProximityForest(random_state=seed, n_jobs=1, splitters=splitters())
         start = time.process_time()
