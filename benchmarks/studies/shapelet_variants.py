@@ -1,0 +1,82 @@
+"""The shapelet classifier's draw: each variant of its defaults, on the halves.
+
+Usage::
+
+    python benchmarks/studies/shapelet_variants.py --data-dir ../shared/ucr --halves A B \
+        --seeds 0 1 2 --variants default normalised-0.8 raw rdst \
+        --out results/shapelet_variants.jsonl
+
+For every dataset, seed and variant, ``GeodesicShapeletClassifier(random_state=seed,
+n_jobs=1)`` is fitted on one thread with the parameters the variant names, and its test
+accuracy and fit and prediction CPU seconds are kept (JSON lines, appended as each
+dataset finishes; a rerun skips what is there). The mean accuracy per half and seed is
+printed: a variant becomes the default only if it wins where defaults are chosen
+(halves A and C1) and is confirmed on B and C2. Variants:
+
+* ``default``: as shipped (half the shapelets normalised; from the series and their
+  velocity, shapelet by shapelet);
+* ``normalised-0.8``: ``normalised_fraction=0.8``, aeon's RDST default;
+* ``raw``: ``representation="raw"``, shapelets from the series only, as RDST draws them;
+* ``rdst``: both, RDST's draw (but for its alpha-similarity mask).
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the repository
+
+from benchmarks.studies._halves_cli import (
+    halves_parser,
+    measure_missing,
+    print_half_means,
+    read_records,
+)
+from benchmarks.ucr._data import load_split
+from sk_rtw import GeodesicShapeletClassifier
+
+VARIANTS = {
+    "default": {},
+    "normalised-0.8": {"normalised_fraction": 0.8},
+    "raw": {"representation": "raw"},
+    "rdst": {"representation": "raw", "normalised_fraction": 0.8},
+}
+
+
+def measure(name: str, seed: int, data_dir: str, variants: list[str]) -> dict:
+    train, test = load_split(name, "train", data_dir), load_split(name, "test", data_dir)
+    record: dict = {"dataset": name, "seed": seed}
+    for variant in variants:
+        classifier = GeodesicShapeletClassifier(**VARIANTS[variant], random_state=seed,
+                                                n_jobs=1)  # fmt: skip
+        start = time.process_time()
+        classifier.fit(train.X, train.y)
+        fit = time.process_time() - start
+        start = time.process_time()
+        record[variant] = float(np.mean(classifier.predict(test.X) == test.y))
+        record[f"{variant}_fit"] = fit
+        record[f"{variant}_predict"] = time.process_time() - start
+    print(name, seed, {v: round(record[v], 4) for v in variants}, flush=True)
+    return record
+
+
+def main(argv=None) -> None:
+    parser = halves_parser(__doc__.splitlines()[0], out_required=False)
+    parser.add_argument("--variants", nargs="+", default=list(VARIANTS), choices=list(VARIANTS))
+    args = parser.parse_args(argv)
+    records = [r for r in read_records(args.out) if all(v in r for v in args.variants)]
+
+    def one(name: str, seed: int, data_dir: str) -> dict:
+        return measure(name, seed, data_dir, args.variants)
+
+    for _ in measure_missing(args, records, one):
+        pass
+    print_half_means(records, args, args.variants)
+
+
+if __name__ == "__main__":
+    main()
