@@ -19,6 +19,8 @@ demonstration ``k`` of every shape and trains on the other three (4 folds, 30 cl
 * ``minirocket-velocity``: MiniRocket on the tangent velocity
   (``make_pipeline(TangentVelocity(space, output="aeon"), MiniRocketClassifier())``);
 * ``shapelets``: ``GeodesicShapeletClassifier(manifold=...)``, the library's defaults;
+* ``shapelets-rdst``: the same with RDST's draw (``representation="raw",
+  normalised_fraction=0.8``: shapelets from the series only, 80 % normalised);
 * ``forest-shapelets``: the forest with elastic and shapelet candidates
   (``splitters=[ElasticSplitter(), ShapeletSplitter()]``).
 
@@ -68,7 +70,7 @@ from sk_rtw.manifolds import quaternion_product
 
 SPACES = ("quaternion", "spd")
 ROWS = ("prototype", "nearest-centroid", "forest", "1nn-dtw", "1nn-dtw-velocity", "minirocket",
-        "minirocket-velocity", "shapelets", "forest-shapelets")  # fmt: skip
+        "minirocket-velocity", "shapelets", "shapelets-rdst", "forest-shapelets")  # fmt: skip
 
 
 def in_own_frames(demos: np.ndarray, space: str, seed: int) -> np.ndarray:
@@ -122,9 +124,11 @@ def run_fold(space, demos, shapes, fold, rows, method, seed, verbose, manifold=N
             start = time.perf_counter()
             predicted = model.predict(X_test)
             extra = {"decision": model.decision_} if row == "prototype" else {}
-        elif row in ("forest", "forest-shapelets", "shapelets"):
-            if row == "shapelets":
-                model = GeodesicShapeletClassifier(manifold=space, random_state=seed, n_jobs=1)
+        elif row in ("forest", "forest-shapelets", "shapelets", "shapelets-rdst"):
+            if row.startswith("shapelets"):
+                rdst = {"representation": "raw", "normalised_fraction": 0.8}
+                model = GeodesicShapeletClassifier(manifold=space, random_state=seed, n_jobs=1,
+                                                   **(rdst if row == "shapelets-rdst" else {}))
             else:
                 splitters = [ElasticSplitter(), ShapeletSplitter()] if row != "forest" else None
                 model = RTWProximityForest(manifold=space, random_state=seed, n_jobs=1,
@@ -185,7 +189,7 @@ def warm_up(rows) -> None:
         RTWNearestCentroid(method=method_object("rtw", n_epochs=2)).fit(X, y).predict(X)
     if "forest" in rows:
         RTWProximityForest(n_trees=2, random_state=0).fit(X, y).predict(X)
-    if "shapelets" in rows or "forest-shapelets" in rows:
+    if {"shapelets", "shapelets-rdst", "forest-shapelets"} & set(rows):
         GeodesicShapeletClassifier(n_shapelets=20, random_state=0).fit(X, y).predict(X)
 
 
