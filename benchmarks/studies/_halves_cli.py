@@ -69,3 +69,22 @@ def print_half_means(records: list[dict], args: argparse.Namespace, columns: lis
             if rows:
                 means = " | ".join(f"{np.mean([r[c] for r in rows]):.4f}" for c in columns)
                 print(f"| {half} | {seed} | {len(rows)} | {means} |", flush=True)
+
+
+def run_variants(
+    description: str, variants: dict, measure: Callable[[str, int, str, list[str]], dict]
+) -> None:
+    """The command line of a study of named ``variants``: ``--variants`` (default all),
+    the records of ``--out`` that hold every variant asked for, ``measure(name, seed,
+    data_dir, variants)`` for the datasets and seeds they lack, the means per half."""
+    parser = halves_parser(description, out_required=False)
+    parser.add_argument("--variants", nargs="+", default=list(variants), choices=list(variants))
+    args = parser.parse_args()
+    records = [r for r in read_records(args.out) if all(v in r for v in args.variants)]
+
+    def one(name: str, seed: int, data_dir: str) -> dict:
+        return measure(name, seed, data_dir, args.variants)
+
+    for _ in measure_missing(args, records, one):
+        pass
+    print_half_means(records, args, args.variants)

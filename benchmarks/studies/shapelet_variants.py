@@ -30,12 +30,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the repository
 
-from benchmarks.studies._halves_cli import (
-    halves_parser,
-    measure_missing,
-    print_half_means,
-    read_records,
-)
+from benchmarks.studies._halves_cli import run_variants
 from benchmarks.ucr._data import load_split
 from sk_rtw import GeodesicShapeletClassifier
 
@@ -64,18 +59,8 @@ def measure(name: str, seed: int, data_dir: str, variants: list[str]) -> dict:
     return record
 
 
-def main(argv=None) -> None:
-    parser = halves_parser(__doc__.splitlines()[0], out_required=False)
-    parser.add_argument("--variants", nargs="+", default=list(VARIANTS), choices=list(VARIANTS))
-    args = parser.parse_args(argv)
-    records = [r for r in read_records(args.out) if all(v in r for v in args.variants)]
-
-    def one(name: str, seed: int, data_dir: str) -> dict:
-        return measure(name, seed, data_dir, args.variants)
-
-    for _ in measure_missing(args, records, one):
-        pass
-    print_half_means(records, args, args.variants)
+def main() -> None:
+    run_variants(__doc__.splitlines()[0], VARIANTS, measure)
 
 
 if __name__ == "__main__":

@@ -325,6 +325,17 @@ def series_window_profile(series, n_windows, shapelet, dilation, normalise, pair
 
 
 @njit(cache=True, nogil=True, inline="always")
+def _feature_value(feature, best, where, count):
+    """Feature ``feature`` of :func:`shapelet_features` (0 the smallest distance, 1 the
+    first window where it lies, 2 the occurrences) from a series' running values."""
+    if feature == 0:
+        return best
+    if feature == 1:
+        return float(where)
+    return float(count)
+
+
+@njit(cache=True, nogil=True, inline="always")
 def _batch_window_stats(values, n_windows, length, dilation, floor, means, scales):
     """Mean and scale of the z-normalisation of every window of a univariate series
     ``values``, summed as numpy sums a batch (one term after the other), all windows at
@@ -393,12 +404,7 @@ def _normalised_univariate_feature(data, rows, n_windows, shapelet, dilation, fl
                 count += 1
             if total < best:
                 best, where = total, t
-        if feature == 0:
-            out[i] = best
-        elif feature == 1:
-            out[i] = where
-        else:
-            out[i] = count
+        out[i] = _feature_value(feature, best, where, count)
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -421,12 +427,7 @@ def _feature_in_place(data, rows, n_windows, shapelet, dilation, normalise, univ
                 count += 1
             if total < best:
                 best, where = total, t
-        if feature == 0:
-            out[i] = best
-        elif feature == 1:
-            out[i] = where
-        else:
-            out[i] = count
+        out[i] = _feature_value(feature, best, where, count)
 
 
 @njit(cache=True, nogil=True)
