@@ -7,8 +7,10 @@ from __future__ import annotations
 
 import argparse
 import json
+import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -71,19 +73,45 @@ def print_half_means(records: list[dict], args: argparse.Namespace, columns: lis
                 print(f"| {half} | {seed} | {len(rows)} | {means} |", flush=True)
 
 
+
+def score_variants(
+    name: str, seed: int, data_dir: str, variants: list[str],
+    build: Callable[[str, int], Any], clock: Callable[[], float],
+) -> dict:
+    """One record: for every variant, ``build(variant, seed)`` fitted on the training
+    split of ``name`` and scored on its test split, with its fit and prediction seconds
+    (``clock``)."""
+    from benchmarks.ucr._data import load_split
+
+    train, test = load_split(name, "train", data_dir), load_split(name, "test", data_dir)
+    record: dict = {"dataset": name, "seed": seed}
+    for variant in variants:
+        model = build(variant, seed)
+        start = clock()
+        model.fit(train.X, train.y)
+        fit = clock() - start
+        start = clock()
+        record[variant] = float(np.mean(model.predict(test.X) == test.y))
+        record[f"{variant}_fit"] = fit
+        record[f"{variant}_predict"] = clock() - start
+    print(name, seed, {v: round(record[v], 4) for v in variants}, flush=True)
+    return record
+
+
 def run_variants(
-    description: str, variants: dict, measure: Callable[[str, int, str, list[str]], dict]
+    description: str, variants: dict, build: Callable[[str, int], Any],
+    clock: Callable[[], float] = time.perf_counter,
 ) -> None:
     """The command line of a study of named ``variants``: ``--variants`` (default all),
-    the records of ``--out`` that hold every variant asked for, ``measure(name, seed,
-    data_dir, variants)`` for the datasets and seeds they lack, the means per half."""
+    the records of ``--out`` that hold every variant asked for, :func:`score_variants`
+    for the datasets and seeds they lack, the means per half."""
     parser = halves_parser(description, out_required=False)
     parser.add_argument("--variants", nargs="+", default=list(variants), choices=list(variants))
     args = parser.parse_args()
     records = [r for r in read_records(args.out) if all(v in r for v in args.variants)]
 
     def one(name: str, seed: int, data_dir: str) -> dict:
-        return measure(name, seed, data_dir, args.variants)
+        return score_variants(name, seed, data_dir, args.variants, build, clock)
 
     for _ in measure_missing(args, records, one):
         pass

@@ -22,39 +22,19 @@ passed as the forest's ``splitters``.
 from __future__ import annotations
 
 import sys
-import time
 from pathlib import Path
-
-import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the repository
 
 from benchmarks.studies._halves_cli import run_variants
-from benchmarks.ucr._data import load_split
 from sk_rtw import ElasticSplitter, RTWProximityForest
 
 VARIANTS = {"default": ElasticSplitter(), "exponents-1-2": ElasticSplitter(exponents=(1.0, 2.0))}
 
 
-def measure(name: str, seed: int, data_dir: str, variants: list[str]) -> dict:
-    train, test = load_split(name, "train", data_dir), load_split(name, "test", data_dir)
-    record: dict = {"dataset": name, "seed": seed}
-    for variant in variants:
-        forest = RTWProximityForest(splitters=[VARIANTS[variant]], random_state=seed, n_jobs=1)
-        start = time.perf_counter()
-        forest.fit(train.X, train.y)
-        fit = time.perf_counter() - start
-        start = time.perf_counter()
-        predictions = forest.predict(test.X)
-        record[variant] = float(np.mean(predictions == test.y))
-        record[f"{variant}_fit"] = fit
-        record[f"{variant}_predict"] = time.perf_counter() - start
-    print(name, seed, {v: round(record[v], 4) for v in variants}, flush=True)
-    return record
-
-
 def main() -> None:
-    run_variants(__doc__.splitlines()[0], VARIANTS, measure)
+    run_variants(__doc__.splitlines()[0], VARIANTS, lambda variant, seed: RTWProximityForest(
+        splitters=[VARIANTS[variant]], random_state=seed, n_jobs=1))  # fmt: skip
 
 
 if __name__ == "__main__":

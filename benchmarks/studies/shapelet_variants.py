@@ -26,12 +26,9 @@ import sys
 import time
 from pathlib import Path
 
-import numpy as np
-
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the repository
 
 from benchmarks.studies._halves_cli import run_variants
-from benchmarks.ucr._data import load_split
 from sk_rtw import GeodesicShapeletClassifier
 
 VARIANTS = {
@@ -42,25 +39,10 @@ VARIANTS = {
 }
 
 
-def measure(name: str, seed: int, data_dir: str, variants: list[str]) -> dict:
-    train, test = load_split(name, "train", data_dir), load_split(name, "test", data_dir)
-    record: dict = {"dataset": name, "seed": seed}
-    for variant in variants:
-        classifier = GeodesicShapeletClassifier(**VARIANTS[variant], random_state=seed,
-                                                n_jobs=1)  # fmt: skip
-        start = time.process_time()
-        classifier.fit(train.X, train.y)
-        fit = time.process_time() - start
-        start = time.process_time()
-        record[variant] = float(np.mean(classifier.predict(test.X) == test.y))
-        record[f"{variant}_fit"] = fit
-        record[f"{variant}_predict"] = time.process_time() - start
-    print(name, seed, {v: round(record[v], 4) for v in variants}, flush=True)
-    return record
-
-
 def main() -> None:
-    run_variants(__doc__.splitlines()[0], VARIANTS, measure)
+    run_variants(__doc__.splitlines()[0], VARIANTS, lambda variant, seed: (
+        GeodesicShapeletClassifier(**VARIANTS[variant], random_state=seed, n_jobs=1)),
+        clock=time.process_time)  # fmt: skip
 
 
 if __name__ == "__main__":
