@@ -19,10 +19,11 @@ poses; ``align`` (RTW on each, TTW and NTW on three); and the estimators on aeon
 GunPoint, ItalyPowerDemand and ArrowHead (the default nearest-centroid classifier with
 DBA and with a short RTW, the representation choice, the prototype classifier with an
 int and with a RandomState seed, the proximity forest with series and with mean
-exemplars, k-means: probabilities or scores, predictions, choices, means, out-of-fold
-distances) and on generated quaternion and SPD series. ``--quick`` keeps the manifold
-part only (a minute; the estimators need aeon's bundled data). Uses the public API only,
-so the same file runs on any version since the API it calls existed.
+exemplars and the elastic forest alone, k-means: probabilities or scores, predictions,
+choices, means, out-of-fold distances) and on generated quaternion and SPD series.
+``--quick`` keeps the manifold part only (a minute; the estimators need aeon's bundled
+data). Uses the public API only, so the same file runs on any version since the API it
+calls existed.
 """
 
 from __future__ import annotations
@@ -51,6 +52,10 @@ from sk_rtw import (
 )
 from sk_rtw.datasets import make_warped_signals
 from sk_rtw.methods import RTW
+
+#: The elastic forest (Proximity Forest 2.0's recipe alone; the default forest of the
+#: versions before shapelet candidates), where the version has splitters.
+ELASTIC = {"splitters": (sk_rtw.ElasticSplitter(),)} if hasattr(sk_rtw, "ElasticSplitter") else {}
 
 MANIFOLDS = {
     "euc1": sk_rtw.Euclidean(1), "euc3": sk_rtw.Euclidean(3), "s1": sk_rtw.Sphere(1),
@@ -132,6 +137,7 @@ def estimator_part(out: Record) -> None:
                                                    random_state=np.random.RandomState(3)),
             "forest": RTWProximityForest(n_trees=6, random_state=0),
             "forest-mean": RTWProximityForest(n_trees=3, exemplars="mean", random_state=1),
+            "forest-elastic": RTWProximityForest(n_trees=6, random_state=0, **ELASTIC),
         }
         for label, estimator in estimators.items():
             if dataset == "ArrowHead" and label == "nc-rtw8":
@@ -157,11 +163,14 @@ def estimator_part(out: Record) -> None:
         ("quat", 8, 30, {
             "nc": RTWNearestCentroid("quaternion", method=RTW(n_epochs=5), random_state=0),
             "forest": RTWProximityForest("quaternion", n_trees=4, random_state=0),
+            "forest-elastic": RTWProximityForest("quaternion", n_trees=4, random_state=0,
+                                                 **ELASTIC),
             "proto": RTWPrototypeClassifier("quaternion", method="dba", cv=3, random_state=0),
         }),
         ("spd", 6, 25, {
             "nc": RTWNearestCentroid("spd", method="dba", random_state=0),
             "forest": RTWProximityForest("spd", n_trees=3, random_state=0),
+            "forest-elastic": RTWProximityForest("spd", n_trees=3, random_state=0, **ELASTIC),
         }),
     ):  # fmt: skip
         manifold = "quaternion" if name == "quat" else "spd"

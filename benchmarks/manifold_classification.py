@@ -8,8 +8,8 @@ demonstration ``k`` of every shape and trains on the other three (4 folds, 30 cl
 
 * ``prototype``: ``RTWPrototypeClassifier(manifold=...)``, the library's defaults;
 * ``nearest-centroid``: ``RTWNearestCentroid(manifold=...)``, the library's defaults;
-* ``forest``: ``RTWProximityForest(manifold=...)``, the library's defaults (100 trees on
-  the series and their tangent velocity, one thread);
+* ``forest``: ``RTWProximityForest(manifold=...)``, the library's defaults (100 trees,
+  elastic and shapelet candidates on the series and their tangent velocity, one thread);
 * ``1nn-dtw``: 1-NN by manifold DTW (geodesic point cost, no band);
 * ``1nn-dtw-velocity``: 1-NN by DTW of the tangent velocity (``sk_rtw.tangent_velocity``:
   the body angular velocity of the quaternions, the whitened logarithm of the SPD steps;
@@ -21,8 +21,11 @@ demonstration ``k`` of every shape and trains on the other three (4 folds, 30 cl
 * ``shapelets``: ``GeodesicShapeletClassifier(manifold=...)``, the library's defaults;
 * ``shapelets-rdst``: the same with RDST's draw (``representation="raw",
   normalised_fraction=0.8``: shapelets from the series only, 80 % normalised);
-* ``forest-shapelets``: the forest with elastic and shapelet candidates
-  (``splitters=[ElasticSplitter(), ShapeletSplitter()]``).
+* ``forest-shapelets``: the same forest with its splitters written out
+  (``splitters=[ElasticSplitter(), ShapeletSplitter()]``);
+* ``forest-elastic``: the forest with elastic candidates only
+  (``splitters=[ElasticSplitter()]``, Proximity Forest 2.0's recipe; the default forest
+  before shapelet candidates).
 
 ``--frames`` puts every demonstration in a world frame of its own, as a robot's
 demonstrations recorded in different frames: a random rotation and sign per
@@ -70,7 +73,8 @@ from sk_rtw.manifolds import quaternion_product
 
 SPACES = ("quaternion", "spd")
 ROWS = ("prototype", "nearest-centroid", "forest", "1nn-dtw", "1nn-dtw-velocity", "minirocket",
-        "minirocket-velocity", "shapelets", "shapelets-rdst", "forest-shapelets")  # fmt: skip
+        "minirocket-velocity", "shapelets", "shapelets-rdst", "forest-shapelets",
+        "forest-elastic")  # fmt: skip
 
 
 def in_own_frames(demos: np.ndarray, space: str, seed: int) -> np.ndarray:
@@ -124,13 +128,15 @@ def run_fold(space, demos, shapes, fold, rows, method, seed, verbose, manifold=N
             start = time.perf_counter()
             predicted = model.predict(X_test)
             extra = {"decision": model.decision_} if row == "prototype" else {}
-        elif row in ("forest", "forest-shapelets", "shapelets", "shapelets-rdst"):
+        elif row in ("forest", "forest-shapelets", "forest-elastic", "shapelets",
+                     "shapelets-rdst"):  # fmt: skip
             if row.startswith("shapelets"):
                 rdst = {"representation": "raw", "normalised_fraction": 0.8}
                 model = GeodesicShapeletClassifier(manifold=space, random_state=seed, n_jobs=1,
                                                    **(rdst if row == "shapelets-rdst" else {}))
             else:
-                splitters = [ElasticSplitter(), ShapeletSplitter()] if row != "forest" else None
+                splitters = {"forest": None, "forest-elastic": [ElasticSplitter()],
+                             "forest-shapelets": [ElasticSplitter(), ShapeletSplitter()]}[row]
                 model = RTWProximityForest(manifold=space, random_state=seed, n_jobs=1,
                                            splitters=splitters)  # fmt: skip
             model.fit(X_train, y_train)
@@ -187,7 +193,7 @@ def warm_up(rows) -> None:
             MiniRocketClassifier(random_state=0).fit(channels, y).predict(channels)
     if "prototype" in rows or "nearest-centroid" in rows:
         RTWNearestCentroid(method=method_object("rtw", n_epochs=2)).fit(X, y).predict(X)
-    if "forest" in rows:
+    if {"forest", "forest-shapelets", "forest-elastic"} & set(rows):
         RTWProximityForest(n_trees=2, random_state=0).fit(X, y).predict(X)
     if {"shapelets", "shapelets-rdst", "forest-shapelets"} & set(rows):
         GeodesicShapeletClassifier(n_shapelets=20, random_state=0).fit(X, y).predict(X)

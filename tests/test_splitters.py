@@ -41,19 +41,57 @@ def _measures(forest):
     return out
 
 
-def test_the_default_splitter_written_out_is_the_default_forest():
-    X, y = three_classes()
-    test, _ = three_classes(seed=4)
-    default = RTWProximityForest(n_trees=6, random_state=0).fit(X, y)
-    written = ElasticSplitter(
-        n_candidates=5, representation="auto", exemplars="series", exponents=(0.5, 1.0, 2.0),
-        measures=("dtw", "adtw"), max_window=0.25, penalty_steps=100, penalty_exponent=5,
-        penalty_pairs=50, mean_subset=10, mean_iterations=5,
-    )  # fmt: skip
-    explicit = RTWProximityForest(n_trees=6, splitters=[written], random_state=0).fit(X, y)
-    np.testing.assert_array_equal(default.predict_proba(test), explicit.predict_proba(test))
-    assert _measures(default) == _measures(explicit)
-    assert default.splitters_[0].get_params() == written.get_params()
+def _split_kinds(forest):
+    kinds = set()
+    for tree in forest.trees_:
+        stack = [tree.root_]
+        while stack:
+            node = stack.pop()
+            if node.split is not None:
+                kinds.add(type(node.split).__name__)
+                stack.extend(node.children)
+    return kinds
+
+
+def _bumps(n=80, seed=0):
+    """Class 1 has a bump at a random place: a local pattern."""
+    rng = np.random.default_rng(seed)
+    X = rng.standard_normal((n, 60))
+    where = rng.integers(0, 50, size=n)
+    y = np.arange(n) % 2
+    for i in np.flatnonzero(y):
+        X[i, where[i] : where[i] + 8] += np.hanning(8) * 6
+    return X, y
+
+
+def test_the_default_splitters_written_out_are_the_default_forest():
+    """The default forest draws elastic and shapelet candidates with these recipes; the
+    elastic splitter alone is another forest."""
+    from sk_rtw.forest import ShapeletSplitter
+
+    X, y = _bumps()
+    default = RTWProximityForest(n_trees=6, random_state=0).fit(X[:40], y[:40])
+    written = [
+        ElasticSplitter(
+            n_candidates=5, representation="auto", exemplars="series",
+            exponents=(0.5, 1.0, 2.0), measures=("dtw", "adtw"), max_window=0.25,
+            penalty_steps=100, penalty_exponent=5, penalty_pairs=50, mean_subset=10,
+            mean_iterations=5,
+        ),
+        ShapeletSplitter(
+            n_candidates=5, representation="auto", lengths=None, normalised_fraction=0.5,
+            threshold_percentiles=(5.0, 10.0), features=("min", "argmin", "count"),
+        ),
+    ]  # fmt: skip
+    explicit = RTWProximityForest(n_trees=6, splitters=written, random_state=0)
+    explicit.fit(X[:40], y[:40])
+    np.testing.assert_array_equal(default.predict_proba(X[40:]), explicit.predict_proba(X[40:]))
+    assert [s.get_params() for s in default.splitters_] == [s.get_params() for s in written]
+    assert _split_kinds(default) == {"NearestExemplarSplit", "ShapeletSplit"}
+    elastic = RTWProximityForest(n_trees=6, splitters=written[:1], random_state=0)
+    elastic.fit(X[:40], y[:40])
+    assert _split_kinds(elastic) == {"NearestExemplarSplit"}
+    assert not np.array_equal(elastic.predict_proba(X[40:]), default.predict_proba(X[40:]))
 
 
 def test_the_recipe_decides_the_measures_drawn():
@@ -77,8 +115,9 @@ def test_a_splitter_takes_the_forests_values_where_it_sets_none():
     X, y = three_classes()
     forest = RTWProximityForest(n_trees=3, representation="velocity", n_candidates=2,
                                 random_state=0).fit(X, y)  # fmt: skip
-    (resolved,) = forest.splitters_
-    assert (resolved.representation, resolved.n_candidates) == ("velocity", 2)
+    assert len(forest.splitters_) == 2
+    for resolved in forest.splitters_:
+        assert (resolved.representation, resolved.n_candidates) == ("velocity", 2)
     raw = [ElasticSplitter(representation="raw")]
     own = RTWProximityForest(n_trees=3, representation="velocity", random_state=0,
                              splitters=raw).fit(X, y)  # fmt: skip

@@ -5,13 +5,15 @@ Usage::
     python benchmarks/studies/forest_measures.py --data-dir ../shared/ucr --halves A \
         --seeds 0 1 2 --variants default exponents-1-2 --out results/forest_measures.jsonl
 
-For every dataset, seed and variant, :class:`sk_rtw.RTWProximityForest(random_state=seed,
-n_jobs=1)` is fitted on one thread with its measure family changed as the variant says,
+For every dataset, seed and variant, the elastic forest
+(:class:`sk_rtw.RTWProximityForest(random_state=seed, n_jobs=1)` with one
+:class:`sk_rtw.ElasticSplitter`, no shapelet candidates) is fitted on one thread with its
+measure family changed as the variant says,
 and its test accuracy, fit and prediction seconds are kept (JSON lines, appended as each
 dataset finishes; a rerun skips what is there). The mean accuracy per half and seed is
 printed. Variants:
 
-* ``default``: the forest as shipped (point-cost exponents 1/2, 1 and 2);
+* ``default``: the elastic splitter as shipped (point-cost exponents 1/2, 1 and 2);
 * ``exponents-1-2``: the geodesic distance or its square only (the issue's first draft,
   without Proximity Forest 2.0's exponent 1/2).
 

@@ -15,12 +15,16 @@ For one dataset and each method:
    ``rtw-prototype`` and ``dba-prototype`` are :class:`sk_rtw.RTWPrototypeClassifier`
    with that method (the default classifier's centroids, out-of-fold distances to every
    centroid and a linear readout); ``rtw-forest`` is :class:`sk_rtw.RTWProximityForest`
-   (no averaging: a forest of proximity trees on the series and their tangent velocity),
-   ``rtw-forest-raw`` the same without the velocity, ``rtw-forest-mean`` with DBA means of
-   random class subsets as exemplars; ``aeon-dba`` is aeon's ``elastic_barycenter_average``
-   with DTW (a reference where the data are Euclidean); ``minirocket`` is aeon's
-   ``MiniRocketClassifier`` (the field's default classifier; unequal-length series are
-   linearly resampled to the longest training length first, which it needs);
+   as shipped (no averaging: a forest of proximity trees with elastic and shapelet
+   candidates on the series and their tangent velocity), ``rtw-forest-shapelets`` the
+   same with its splitters written out, ``rtw-forest-elastic`` the elastic candidates
+   alone (Proximity Forest 2.0's recipe, the default forest before shapelet candidates),
+   ``rtw-forest-raw`` that elastic forest without the velocity, ``rtw-forest-mean`` with
+   DBA means of random class subsets as exemplars; ``aeon-dba`` is aeon's
+   ``elastic_barycenter_average`` with DTW (a reference where the data are Euclidean);
+   ``minirocket`` is aeon's ``MiniRocketClassifier`` (the field's default classifier;
+   unequal-length series are linearly resampled to the longest training length first,
+   which it needs);
 2. averaging values, per training series: ``alignment`` = DTW of the *warped* (aligned)
    series to its class mean (the paper's averaging score; not for aeon's DBA) and
    ``barycenter`` = DTW of the unwarped series to its class mean;
@@ -106,14 +110,15 @@ ESTIMATOR_METHODS: dict[str, tuple[str, dict, str, dict]] = {
     "rtw-prototype": ("rtw", {}, "class-means", {}),
     "dba-prototype": ("dba", {}, "class-means", {}),
 }
-#: Rows of RTWProximityForest: the default forest, and its measured alternatives (no
-#: tangent velocity; DBA means of random class subsets as exemplars).
+#: Rows of RTWProximityForest: the default forest (elastic and shapelet candidates, 5 of
+#: each at every node), the same written out, and the elastic forest with its measured
+#: alternatives (no tangent velocity; DBA means of random class subsets as exemplars).
 FOREST_METHODS: dict[str, dict] = {
     "rtw-forest": {},
-    "rtw-forest-raw": {"representation": "raw"},
-    "rtw-forest-mean": {"exemplars": "mean"},
-    # elastic and shapelet candidates at every node (5 of each)
     "rtw-forest-shapelets": {"splitters": (ElasticSplitter(), ShapeletSplitter())},
+    "rtw-forest-elastic": {"splitters": (ElasticSplitter(),)},
+    "rtw-forest-raw": {"splitters": (ElasticSplitter(),), "representation": "raw"},
+    "rtw-forest-mean": {"splitters": (ElasticSplitter(),), "exemplars": "mean"},
 }
 #: Rows of the classifier a user gets by default.
 DEFAULT_CLASSIFIERS = tuple(m for m in ESTIMATOR_METHODS if m.endswith("-default"))

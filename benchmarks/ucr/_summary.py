@@ -132,7 +132,7 @@ def verdict(records: list[dict], methods: list[str]) -> list[str]:
 
 
 #: The library's most accurate classifiers, and the references they are read beside.
-BEST_ROWS = ("rtw-forest", "rtw-forest-shapelets", "rtw-shapelets")
+BEST_ROWS = ("rtw-forest", "rtw-forest-shapelets", "rtw-forest-elastic", "rtw-shapelets")
 BEST_REFERENCES = ("minirocket", "rdst", "1nn-dtw")
 
 

@@ -20,7 +20,7 @@ _FOREST = RTWProximityForest._declaration  # type: ignore[attr-defined]
 
 @declare_parameters(_FOREST.parameters, defaults={**_FOREST.defaults, "n_jobs": 1})
 class RTWProximityForestClassifier(DelegatingClassifier):
-    """Proximity Forest on manifold DTW and the tangent velocity, as an aeon estimator.
+    """Proximity Forest on manifold DTW and geodesic shapelets, as an aeon estimator.
 
     :class:`sk_rtw.RTWProximityForest` (its parameters, defaults and predictions) behind
     aeon's :class:`~aeon.classification.base.BaseClassifier`: it takes aeon's layouts as
@@ -65,7 +65,7 @@ class RTWProximityForestClassifier(DelegatingClassifier):
         "capability:unequal_length": True,
         "capability:multithreading": True,
         "X_inner_type": ["np-list", "numpy3D"],
-        "algorithm_type": "distance",
+        "algorithm_type": "hybrid",  # elastic distances and shapelets
     }
     _wrapped = RTWProximityForest
 

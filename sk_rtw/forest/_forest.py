@@ -68,25 +68,32 @@ def share_exemplars(trees: list[ProximityTree], training: TrainingSet) -> None:
 
 @declare_parameters(FOREST_PARAMETERS, FOREST_DEFAULTS)
 class RTWProximityForest(ClassifierMixin, BaseEstimator):
-    """Proximity Forest on any manifold: trees that split by the nearest exemplar under
-    a randomly drawn manifold-DTW measure, on the series or their tangent velocity.
+    """Proximity Forest on any manifold, with local patterns: trees that split by the
+    nearest exemplar under a randomly drawn manifold-DTW measure or by a geodesic
+    dilated shapelet, on the series or their tangent velocity.
 
-    Each tree splits a node by drawing ``n_candidates`` candidate splits and keeping the
-    one with the largest Gini gain; a candidate draws one training series per class of
-    the node as exemplars and a measure of the manifold-DTW family, and sends every
-    series of the node to the branch of its nearest exemplar. The measure draws, as
-    Proximity Forest 2.0 (Herrmann et al. 2023) draws its DTW family: the representation
-    (the series, or their tangent velocity: the manifold's derivative series,
-    :func:`sk_rtw.tangent_velocity`), the point cost (the geodesic distance to the power
-    1/2, 1 or 2), and either DTW in a Sakoe-Chiba band of radius up to a quarter of the
-    length, or amerced DTW without a band (a penalty on every step off the diagonal,
-    drawn on a scale taken from the node's series). The draw's recipe (exponents, bands,
-    penalties) is a parameter object, :class:`~sk_rtw.forest.ElasticSplitter`, and
-    ``splitters=`` takes any kinds of split that follow its protocol. Trees split until
-    their leaves are pure; ``predict_proba`` averages the class proportions of the
-    leaves the series reach in every tree (with pure leaves: the trees' vote). The
-    nearest exemplar is found by the package's nearest search (lower bounds, early
-    abandoning, the exhaustive answer).
+    Each tree splits a node by drawing candidate splits from its splitters and keeping
+    the one with the largest Gini gain. An elastic candidate
+    (:class:`~sk_rtw.forest.ElasticSplitter`, Proximity Forest's) draws one training
+    series per class of the node as exemplars and a measure of the manifold-DTW family,
+    and sends every series of the node to the branch of its nearest exemplar. The
+    measure draws, as Proximity Forest 2.0 (Herrmann et al. 2023) draws its DTW family:
+    the representation (the series, or their tangent velocity: the manifold's derivative
+    series, :func:`sk_rtw.tangent_velocity`), the point cost (the geodesic distance to
+    the power 1/2, 1 or 2), and either DTW in a Sakoe-Chiba band of radius up to a
+    quarter of the length, or amerced DTW without a band (a penalty on every step off
+    the diagonal, drawn on a scale taken from the node's series). A shapelet candidate
+    (:class:`~sk_rtw.forest.ShapeletSplitter`, TS-CHIEF's recipe with RDST's features)
+    draws a dilated subsequence of one of the node's series and one of its features (the
+    minimum sliding geodesic distance, its position, or how often the distance falls
+    below a threshold) and splits at the feature's best Gini threshold: it sees a short
+    pattern wherever it occurs, which whole-series measures miss. By default a node
+    draws ``n_candidates`` of each kind; ``splitters=(ElasticSplitter(),)`` is Proximity
+    Forest 2.0's elastic forest alone, and ``splitters=`` takes any kinds of split that
+    follow the protocol, each with its recipe. Trees split until their leaves are pure;
+    ``predict_proba`` averages the class proportions of the leaves the series reach in
+    every tree (with pure leaves: the trees' vote). The nearest exemplar is found by the
+    package's nearest search (lower bounds, early abandoning, the exhaustive answer).
 
     When to pick it: it is the most accurate classifier of the package where classes
     differ in shape details (UCR page of the documentation: ahead of
@@ -98,7 +105,7 @@ class RTWProximityForest(ClassifierMixin, BaseEstimator):
     plot or to feed movement models (its exemplars are training series). Fit and
     prediction time grow with ``n_trees``; ``n_jobs`` builds and queries the trees on
     several threads with the same result. The fitted forest keeps what routing needs
-    (every split's exemplar series), not the training set.
+    (every elastic split's exemplar series, every shapelet), not the training set.
 
     Measured (UCR page, one thread, 100 trees): on UCR datasets of 16-180 training
     series, 0.90-0.93 mean accuracy where :class:`RTWNearestCentroid` reads 0.85-0.86

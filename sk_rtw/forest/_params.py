@@ -10,6 +10,7 @@ from ..representations import REPRESENTATIONS
 from ..utils._constraints import Constant, Interval, Options, Satisfies
 from ..utils._params import Parameter
 from ._elastic import EXEMPLAR_KINDS, REPRESENTATION_OPTIONS, ElasticSplitter
+from ._shapelet import ShapeletSplitter
 from ._splitter import Splitter
 
 
@@ -23,7 +24,7 @@ def _is_splitters(value: Any) -> bool:
 SPLITTERS = Parameter(
     "splitters",
     (
-        Constant(None, "(ElasticSplitter(),)"),
+        Constant(None, "(ElasticSplitter(), ShapeletSplitter())"),
         Satisfies(
             "sequence of Splitter",
             "a non-empty sequence of Splitter objects",
@@ -31,8 +32,10 @@ SPLITTERS = Parameter(
         ),
     ),
     "The kinds of split a node draws candidates from, each with its recipe (None: "
-    "Proximity Forest's, ``(ElasticSplitter(),)``); a node keeps the candidate of the "
-    "largest Gini gain over all of them, the first drawn of equal gains.",
+    "``(ElasticSplitter(), ShapeletSplitter())``, Proximity Forest's elastic candidates "
+    "and as many geodesic dilated shapelets, TS-CHIEF's recipe with RDST's features; "
+    "``(ElasticSplitter(),)`` is Proximity Forest's alone); a node keeps the candidate of "
+    "the largest Gini gain over all of them, the first drawn of equal gains.",
 )
 N_CANDIDATES = Parameter(
     "n_candidates",
@@ -69,7 +72,7 @@ def resolve_splitters(values: Mapping[str, Any]) -> tuple[Splitter, ...]:
     None values replaced by the tree's or forest's)."""
     splitters = values["splitters"]
     if splitters is None:
-        splitters = (ElasticSplitter(),)
+        splitters = (ElasticSplitter(), ShapeletSplitter())
     return tuple(s.resolved(values) for s in splitters)
 
 

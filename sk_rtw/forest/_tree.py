@@ -135,11 +135,12 @@ class ProximityTree(ClassifierMixin, BaseEstimator):
     """One proximity tree: a classifier of its own, and the member of
     :class:`~sk_rtw.RTWProximityForest`.
 
-    Every node draws candidate splits from its splitters (Proximity Forest's by default:
-    the nearest of one exemplar per class under a manifold-DTW measure drawn at random,
-    :class:`~sk_rtw.forest.ElasticSplitter`), keeps the one with the largest Gini gain and
-    splits until its leaves are pure. A forest averages many; alone, a tree is a quick,
-    readable, high-variance classifier.
+    Every node draws candidate splits from its splitters (by default two kinds: the
+    nearest of one exemplar per class under a manifold-DTW measure drawn at random,
+    :class:`~sk_rtw.forest.ElasticSplitter`, and a geodesic dilated shapelet's feature at
+    its best threshold, :class:`~sk_rtw.forest.ShapeletSplitter`), keeps the one with the
+    largest Gini gain and splits until its leaves are pure. A forest averages many;
+    alone, a tree is a quick, readable, high-variance classifier.
 
     Parameters
     ----------
