@@ -160,6 +160,30 @@ def test_gini_and_its_gain_by_hand():
     assert gini_gain(codes, np.zeros(6, dtype=int), 2, 3) == pytest.approx(0.0)
 
 
+def _numpy_gini_gain(codes, branches, n_branches, n_classes):
+    """The gain as first written, in numpy: what the compiled one must equal bit for bit
+    (a different last bit can change which candidate of equal gains a node keeps)."""
+    table = np.zeros((n_branches, n_classes))
+    np.add.at(table, (branches, codes), 1.0)
+    sizes = table.sum(1)
+    filled = sizes > 0
+    children = sizes[filled] - (table[filled] ** 2).sum(1) / sizes[filled]
+    return gini(codes, n_classes) - float(children.sum()) / len(codes)
+
+
+@pytest.mark.parametrize("n_branches", [2, 3, 7, 8, 9, 17, 24, 60, 130, 300])
+def test_the_compiled_gini_gain_is_the_numpy_formula_bit_for_bit(n_branches):
+    rng = np.random.default_rng(n_branches)
+    for n in (1, 2, 5, 40, 333, 4000):
+        n_classes = int(rng.integers(2, n_branches + 2))
+        codes = rng.integers(0, n_classes, n)
+        branches = rng.integers(0, min(n_branches, int(rng.integers(1, n_branches + 1))), n)
+        expected = _numpy_gini_gain(codes, branches, n_branches, n_classes)
+        assert gini_gain(codes, branches, n_branches, n_classes) == expected
+        impurity = gini(codes, n_classes)
+        assert gini_gain(codes, branches, n_branches, n_classes, impurity) == expected
+
+
 def test_the_penalty_scale_is_the_mean_direct_alignment_cost(rng):
     X = [rng.standard_normal(n) for n in (20, 20, 26)]
     prepared = prepare_series(check_series_collection(X))

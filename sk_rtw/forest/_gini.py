@@ -6,6 +6,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ..dtw._sliding import _pairwise_sum
+
 
 def gini(codes: np.ndarray, n_classes: int) -> float:
     """Gini impurity of class codes: ``1 - sum_c p_c^2``."""
@@ -15,14 +17,45 @@ def gini(codes: np.ndarray, n_classes: int) -> float:
     return float(1.0 - p @ p)
 
 
-def gini_gain(codes: np.ndarray, branches: np.ndarray, n_branches: int, n_classes: int) -> float:
-    """The impurity of ``codes`` less the size-weighted impurity of its branches."""
+def gini_gain(
+    codes: np.ndarray,
+    branches: np.ndarray,
+    n_branches: int,
+    n_classes: int,
+    impurity: float | None = None,
+) -> float:
+    """The impurity of ``codes`` less the size-weighted impurity of its branches;
+    ``impurity``: :func:`gini` of ``codes``, if known."""
+    if impurity is None:
+        impurity = gini(codes, n_classes)
+    children = _children_impurity(np.asarray(codes, dtype=np.int64),
+                                  np.asarray(branches, dtype=np.int64), int(n_branches),
+                                  int(n_classes))  # fmt: skip
+    return float(impurity) - children / len(codes)
+
+
+@njit(cache=True, nogil=True)
+def _children_impurity(codes, branches, n_branches, n_classes):
+    """``sum_b (n_b - sum_c n_bc^2 / n_b)`` over the non-empty branches, summed as numpy
+    sums that array (its pairwise order; the class counts' squares are whole numbers,
+    exact in any order): the value of ``children.sum()`` in the formula it replaces."""
     table = np.zeros((n_branches, n_classes))
-    np.add.at(table, (branches, codes), 1.0)
-    sizes = table.sum(1)
-    filled = sizes > 0
-    children = sizes[filled] - (table[filled] ** 2).sum(1) / sizes[filled]
-    return gini(codes, n_classes) - float(children.sum()) / len(codes)
+    for i in range(codes.shape[0]):
+        table[branches[i], codes[i]] += 1.0
+    children = np.empty((n_branches, 1))
+    m = 0
+    for b in range(n_branches):
+        size = 0.0
+        squares = 0.0
+        for c in range(n_classes):
+            size += table[b, c]
+            squares += table[b, c] * table[b, c]
+        if size > 0.0:
+            children[m, 0] = size - squares / size
+            m += 1
+    if m == 0:
+        return 0.0
+    return 0.0 + _pairwise_sum(children, m, 0)
 
 
 @njit(cache=True, nogil=True)

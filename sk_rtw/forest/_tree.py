@@ -109,7 +109,8 @@ def best_split(
     for splitter in splitters:
         for _ in range(splitter.n_candidates or 0):
             split, branches = splitter.candidate(node, rng)
-            gain = gini_gain(node.codes, branches, split.n_branches, node.n_classes)
+            gain = gini_gain(node.codes, branches, split.n_branches, node.n_classes,
+                             node.impurity)  # fmt: skip
             if best is None or gain > best[1]:
                 best = split, gain, branches
     assert best is not None  # every splitter draws at least one candidate
