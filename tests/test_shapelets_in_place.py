@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from sk_rtw import ElasticSplitter, RTWProximityForest
-from sk_rtw.dtw import linear_percentiles, read_window
+from sk_rtw.dtw import linear_percentiles, numpy_column_sum, read_window
 from sk_rtw.forest import ShapeletSplitter
 from sk_rtw.manifolds import Euclidean
 from sk_rtw.manifolds._euclidean import STD_FLOOR
@@ -74,6 +74,14 @@ def test_linear_percentiles_are_numpys():
         out = np.empty(len(percentiles))
         linear_percentiles(values, n, percentiles, out)
         np.testing.assert_array_equal(out, np.percentile(values[:n], percentiles))
+
+
+def test_numpy_column_sum_is_numpys_sum():
+    """Lengths across numpy's blocks of 8 and 128 and its halving above them."""
+    rng = np.random.default_rng(1)
+    for n in [*range(0, 40), 127, 128, 129, 255, 256, 257, 1000, 4097]:
+        values = rng.standard_normal(n + 3) * rng.choice([1e-3, 1.0, 1e9], n + 3)
+        assert numpy_column_sum(values.reshape(-1, 1), n, 0) == np.sum(values[:n])
 
 
 def _pool_of(collections, codes, pool, representations):

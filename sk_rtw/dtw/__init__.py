@@ -17,7 +17,8 @@ for many searches on the calling thread (:func:`nearest_group`, and
 and :func:`shapelet_features` slide a shapelet over windows of series (``_sliding``);
 :func:`read_window`, :func:`series_window_profile` and :func:`series_window_feature` read
 the windows of Euclidean series in place (z-normalised as numpy does) and
-:func:`linear_percentiles` is numpy's percentile, for one shapelet at a time.
+:func:`linear_percentiles` is numpy's percentile, for one shapelet at a time;
+:func:`numpy_column_sum` is numpy's sum of a column, in its order.
 
 The modules stand on floors, each importing only those below it: the compiled point
 costs (``_point_costs``, rows of costs from the manifolds' point geometry, which is the
@@ -39,6 +40,7 @@ from ._prepared import EXPONENTS, PreparedSeries, mean_diagonal_cost, nearest_gr
 from ._search import dtw_nearest_distance
 from ._sliding import (
     linear_percentiles,
+    numpy_column_sum,
     read_window,
     series_window_feature,
     series_window_profile,
@@ -66,6 +68,7 @@ __all__ = [
     "medoid_index",
     "multiscale_path",
     "nearest_group",
+    "numpy_column_sum",
     "optimal_path",
     "path_indices",
     "point_cost_matrix",

@@ -221,6 +221,13 @@ def _pairwise_sum(values, n, c):
     return total
 
 
+@njit(cache=True, nogil=True)
+def numpy_column_sum(values, n, c):
+    """``np.sum(values[:n, c])`` of a column numpy reads contiguously (a ``(n, 1)`` array,
+    or a 1-D array's values), bit for bit: ``0 +`` its pairwise sum."""
+    return 0.0 + _pairwise_sum(values, n, c)
+
+
 @njit(cache=True, nogil=True, inline="always")
 def _window_column_sum(values, length, c, pairwise):
     """``0 + values[0, c] + ... + values[length - 1, c]`` in numpy's order."""

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..dtw._sliding import _pairwise_sum
+from ..dtw import numpy_column_sum
 
 
 def gini(codes: np.ndarray, n_classes: int) -> float:
@@ -55,7 +55,7 @@ def _children_impurity(codes, branches, n_branches, n_classes):
             m += 1
     if m == 0:
         return 0.0
-    return 0.0 + _pairwise_sum(children, m, 0)
+    return numpy_column_sum(children, m, 0)
 
 
 @njit(cache=True, nogil=True)
