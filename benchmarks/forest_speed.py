@@ -9,8 +9,9 @@ Usage::
 
 For every dataset of the halves and every seed (after a warm-up forest of two trees on a
 few series, so that compiling is not timed), :class:`sk_rtw.RTWProximityForest`
-(``random_state=seed``, ``n_jobs=1``, everything else default) is fitted and asked to
-predict the test split on one thread; the CPU seconds of each (``time.process_time``:
+(``random_state=seed``, ``n_jobs=1``, everything else default; ``--elastic``: the elastic
+forest, ``splitters=[ElasticSplitter()]``, with an ``--out`` of its own) is fitted and
+asked to predict the test split on one thread; the CPU seconds of each (``time.process_time``:
 wall time depends on what else the machine runs) are kept with the test accuracy, and
 so are the CPU seconds per test series of aeon's 1-NN DTW (full window, one thread) on at
 most ``--dtw-series`` test series. Records are JSON lines appended one dataset at a time
@@ -40,6 +41,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from sklearn.base import clone
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the repository
 
@@ -51,7 +53,7 @@ from benchmarks.studies._halves_cli import (
 from benchmarks.ucr._data import load_split
 from benchmarks.ucr._published import PF2_TIMES, default_published, read_published
 from benchmarks.ucr._summary import FIXED_HALVES
-from sk_rtw import RTWProximityForest
+from sk_rtw import ElasticSplitter, RTWProximityForest
 
 #: Proximity Forest 2.0's C++ seconds on this machine kind over its published seconds.
 PF2_FACTOR = 0.6
@@ -110,7 +112,8 @@ def measure(name: str, seed: int, data_dir: str, args: argparse.Namespace) -> di
 
     train, test = load_split(name, "train", data_dir), load_split(name, "test", data_dir)
     _warm_up(train)
-    forest = RTWProximityForest(random_state=seed, n_jobs=1)
+    splitters = [ElasticSplitter()] if args.elastic else None
+    forest = RTWProximityForest(random_state=seed, n_jobs=1, splitters=splitters)
     before = _rss_bytes()
     _, fit = _cpu(lambda: forest.fit(train.X, train.y))
     peak = max(0, _peak_rss_bytes() - before)  # 0 where the peak came before the fit
@@ -131,8 +134,8 @@ def measure(name: str, seed: int, data_dir: str, args: argparse.Namespace) -> di
         _, dtw = _cpu(lambda: knn.predict(_aeon(queries)))
         record["dtw_per_series"] = dtw / len(rows)
     if args.parallel:
-        one = _wall(lambda: RTWProximityForest(random_state=seed, n_jobs=1).fit(train.X, train.y))
-        two = _wall(lambda: RTWProximityForest(random_state=seed, n_jobs=2).fit(train.X, train.y))
+        one = _wall(lambda: clone(forest).set_params(n_jobs=1).fit(train.X, train.y))
+        two = _wall(lambda: clone(forest).set_params(n_jobs=2).fit(train.X, train.y))
         record["fit_wall_1"], record["fit_wall_2"] = one, two
     return record
 
@@ -196,6 +199,9 @@ def main(argv: list[str] | None = None) -> None:
         help="test series 1-NN DTW predicts per dataset (0: none)")  # fmt: skip
     add("--parallel", action="store_true",
         help="also time the fit with n_jobs=2 against n_jobs=1 (wall seconds)")  # fmt: skip
+    add("--elastic", action="store_true",
+        help="the elastic forest (splitters=[ElasticSplitter()]) instead of the default "
+        "(records of its own: give it another --out)")  # fmt: skip
     add("--pf2-factor", type=float, default=PF2_FACTOR,
         help="PF 2.0's C++ seconds on this machine kind over its published seconds")  # fmt: skip
     add("--published", type=Path, default=None,

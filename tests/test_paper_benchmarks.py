@@ -314,19 +314,27 @@ def test_the_fingerprint_is_reproducible_and_compares(tmp_path, capsys, monkeypa
 def test_the_forest_speed_benchmark_records_a_dataset_and_sums_a_half(monkeypatch, tmp_path):
     """benchmarks/forest_speed.py on a bundled dataset (fewer trees): a record with CPU
     seconds, 1-NN DTW's time a series, the pickle and memory figures, the two-thread fit;
-    the summary divides the half's totals by 0.6x the published seconds."""
-    import functools
-
+    the summary divides the half's totals by 0.6x the published seconds; ``--elastic``
+    measures the forest with the elastic splitter alone."""
     from benchmarks import forest_speed
     from sk_rtw import RTWProximityForest
 
-    few_trees = functools.partial(RTWProximityForest, n_trees=3)
+    splitters = []
+
+    def few_trees(**kwargs):
+        splitters.append(kwargs.get("splitters"))
+        return RTWProximityForest(**{"n_trees": 3, **kwargs})
+
     monkeypatch.setattr(forest_speed, "RTWProximityForest", few_trees)
     args = forest_speed.main.__globals__["halves_parser"]("t", out_required=False).parse_args(
         ["--data-dir", str(tmp_path), "--halves", "B"]
     )
-    args.dtw_series, args.parallel, args.pf2_factor = 4, True, 0.6
+    args.dtw_series, args.parallel, args.pf2_factor, args.elastic = 0, False, 0.6, True
+    forest_speed.measure("ItalyPowerDemand", 0, None, args)
+    assert [type(s).__name__ for s in splitters[-1]] == ["ElasticSplitter"]
+    args.dtw_series, args.parallel, args.elastic = 4, True, False
     record = forest_speed.measure("ItalyPowerDemand", 0, None, args)
+    assert splitters[-1] is None  # the default forest
     assert record["n_train"] == 67 and record["n_test"] == 1029
     assert 0.5 < record["accuracy"] <= 1.0
     for key in ("fit_cpu", "predict_cpu", "dtw_per_series", "fit_wall_1", "fit_wall_2"):
