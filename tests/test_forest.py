@@ -184,6 +184,16 @@ def test_the_compiled_gini_gain_is_the_numpy_formula_bit_for_bit(n_branches):
         assert gini_gain(codes, branches, n_branches, n_classes, impurity) == expected
 
 
+def test_a_gini_gain_of_branches_out_of_range_is_a_clear_error():
+    codes = np.array([0, 1, 1, 0])
+    with pytest.raises(ValueError, match=r"branch outside 0\.\.1"):
+        gini_gain(codes, np.array([0, 2, 1, 0]), 2, 2)
+    with pytest.raises(ValueError, match="class code outside"):
+        gini_gain(np.array([0, 1, 3, 0]), np.array([0, 1, 1, 0]), 2, 2)
+    with pytest.raises(ValueError, match="3 branches for 4 class codes"):
+        gini_gain(codes, np.array([0, 1, 1]), 2, 2)
+
+
 def test_the_penalty_scale_is_the_mean_direct_alignment_cost(rng):
     X = [rng.standard_normal(n) for n in (20, 20, 26)]
     prepared = prepare_series(check_series_collection(X))

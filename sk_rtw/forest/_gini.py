@@ -26,11 +26,18 @@ def gini_gain(
 ) -> float:
     """The impurity of ``codes`` less the size-weighted impurity of its branches;
     ``impurity``: :func:`gini` of ``codes``, if known."""
+    if len(branches) != len(codes):
+        raise ValueError(f"{len(branches)} branches for {len(codes)} class codes")
     if impurity is None:
         impurity = gini(codes, n_classes)
     children = _children_impurity(np.asarray(codes, dtype=np.int64),
                                   np.asarray(branches, dtype=np.int64), int(n_branches),
                                   int(n_classes))  # fmt: skip
+    if np.isnan(children):
+        raise ValueError(
+            f"a branch outside 0..{n_branches - 1} or a class code outside "
+            f"0..{n_classes - 1}"
+        )
     return float(impurity) - children / len(codes)
 
 
@@ -41,7 +48,10 @@ def _children_impurity(codes, branches, n_branches, n_classes):
     exact in any order): the value of ``children.sum()`` in the formula it replaces."""
     table = np.zeros((n_branches, n_classes))
     for i in range(codes.shape[0]):
-        table[branches[i], codes[i]] += 1.0
+        b, c = branches[i], codes[i]
+        if b < 0 or b >= n_branches or c < 0 or c >= n_classes:
+            return np.nan  # the caller names the problem
+        table[b, c] += 1.0
     children = np.empty((n_branches, 1))
     m = 0
     for b in range(n_branches):
