@@ -256,7 +256,8 @@ class ElasticSplitter(Splitter):
     measure drawn at random (the recipe of the draw as parameters).
 
     Pass it in ``splitters=`` of :class:`~sk_rtw.RTWProximityForest` (the default forest
-    holds ``ElasticSplitter()``). Its parameters left as None take the forest's
+    holds ``ElasticSplitter()`` and ``ShapeletSplitter()``; ``[ElasticSplitter()]`` alone
+    is Proximity Forest 2.0's elastic forest). Its parameters left as None take the forest's
     (``n_candidates``, ``representation``, ``exemplars``); the others are the measure
     family, Proximity Forest 2.0's DTW family by default: the geodesic distance to the
     power 1/2, 1 or 2, DTW in a band of radius up to a quarter of the length or amerced

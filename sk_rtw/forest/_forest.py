@@ -95,26 +95,32 @@ class RTWProximityForest(ClassifierMixin, BaseEstimator):
     every tree (with pure leaves: the trees' vote). The nearest exemplar is found by the
     package's nearest search (lower bounds, early abandoning, the exhaustive answer).
 
-    When to pick it: it is the most accurate classifier of the package where classes
-    differ in shape details (UCR page of the documentation: ahead of
-    :class:`RTWNearestCentroid` on most datasets), and the tangent velocity makes it
-    strong on manifold-valued demonstrations (R-LASA page). It costs more: a forest's fit
-    computes about ``n_trees x n_candidates x depth x n_classes`` DTW distances per
-    training series and prediction ``n_trees x depth x n_classes`` per series, where a
-    nearest-centroid classifier computes one per centroid; it gives no class means to
-    plot or to feed movement models (its exemplars are training series). Fit and
-    prediction time grow with ``n_trees``; ``n_jobs`` builds and queries the trees on
-    several threads with the same result. The fitted forest keeps what routing needs
-    (every elastic split's exemplar series, every shapelet), not the training set.
+    When to pick it: it is the most accurate forest of the package (UCR page of the
+    documentation: ahead of :class:`RTWNearestCentroid` on most datasets), its shapelet
+    candidates see short patterns anywhere in the series, and the tangent velocity
+    makes it strong on manifold-valued demonstrations (R-LASA page). It costs more: an
+    elastic candidate computes about one DTW distance per series of the node and class
+    (most abandoned early), so a forest's fit computes about
+    ``n_trees x n_candidates x depth x n_classes`` distances per training series and
+    prediction ``n_trees x depth x n_classes`` per series, where a nearest-centroid
+    classifier computes one per centroid; it gives no class means to plot or to feed
+    movement models (its exemplars are training series). Fit and prediction time grow
+    with ``n_trees``; ``n_jobs`` builds and queries the trees on several threads with
+    the same result. The fitted forest keeps what routing needs (every elastic split's
+    exemplar series, every shapelet), not the training set.
 
-    Measured (UCR page, one thread, 100 trees): on UCR datasets of 16-180 training
-    series, 0.90-0.93 mean accuracy where :class:`RTWNearestCentroid` reads 0.85-0.86
-    (Proximity Forest 1.0's published 0.90, MiniRocket's 0.92-0.93); fit 0.1 s to
-    45 s per dataset, level with Proximity Forest 2.0's C++ on the same machine
-    (0.97-1.05x over a half), prediction 1.01-1.20x it and 1.6-1.7x aeon's 1-NN DTW
-    (median per dataset; faster than 1-NN on long series and large training sets). A
-    training set of 7,200 short series (Crop) takes about 4 minutes to fit (1.6x the
-    C++'s measured time) and 1.3 minutes to predict its 16,800 (0.8x).
+    Measured (UCR page, one thread, 100 trees, three seeds): on UCR datasets of 16-180
+    training series, 0.906-0.925 mean accuracy per half where
+    :class:`RTWNearestCentroid` reads 0.85-0.86 (published: Proximity Forest 2.0
+    0.90-0.93, TS-CHIEF 0.92-0.93, MiniRocket 0.92-0.93), 0.758 on four large training
+    sets (Proximity Forest 2.0 and TS-CHIEF 0.748); fit 0.1 s to 45 s per dataset,
+    level with Proximity Forest 2.0's C++ on the same machine (1.01-1.03x over a half,
+    1.34x on the large sets), prediction 0.70-0.80x it. A training set of 7,200 short
+    series (Crop) takes about 4.5 minutes to fit and 1.3 minutes to predict its 16,800.
+    ``splitters=[ElasticSplitter()]`` is Proximity Forest 2.0's elastic forest alone
+    (this forest's default before shapelet candidates): 0.95-1.04x the fit, 1.3-1.5x
+    the prediction, 0.1 and 0.8 points less on the development halves (three seeds)
+    and 1.0 on the large sets (one).
 
     Parameters
     ----------

@@ -156,10 +156,11 @@ class ShapeletSplitter(Splitter):
     """Splits by a local pattern: one feature of a geodesic dilated shapelet drawn at the
     node, at its best Gini threshold (TS-CHIEF's recipe with RDST's features).
 
-    Pass it with the elastic splitter in ``splitters=`` of
-    :class:`~sk_rtw.RTWProximityForest`: a node then keeps the best of elastic and
-    shapelet candidates. Its None values take the forest's (``n_candidates``,
-    ``representation``); the shortest training series gives the default length.
+    The default forest (:class:`~sk_rtw.RTWProximityForest`) draws it beside the
+    elastic splitter, ``splitters=[ElasticSplitter(), ShapeletSplitter()]``: a node
+    keeps the best of elastic and shapelet candidates. Its None values take the
+    forest's (``n_candidates``, ``representation``); the shortest training series gives
+    the default length.
 
     Parameters
     ----------
