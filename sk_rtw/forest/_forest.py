@@ -118,7 +118,7 @@ class RTWProximityForest(ClassifierMixin, BaseEstimator):
     1.34x on the large sets), prediction 0.70-0.80x it. A training set of 7,200 short
     series (Crop) takes about 4.5 minutes to fit and 1.3 minutes to predict its 16,800.
     ``splitters=[ElasticSplitter()]`` is Proximity Forest 2.0's elastic forest alone
-    (this forest's default before shapelet candidates): 0.95-1.04x the fit, 1.3-1.5x
+    (this forest's default before shapelet candidates): 0.93-0.99x the fit, 1.3-1.5x
     the prediction, 0.1 and 0.8 points less on the development halves (three seeds)
     and 1.0 on the large sets (one).
 
