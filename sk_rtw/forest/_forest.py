@@ -120,7 +120,7 @@ class RTWProximityForest(ClassifierMixin, BaseEstimator):
     ``splitters=[ElasticSplitter()]`` is Proximity Forest 2.0's elastic forest alone
     (this forest's default before shapelet candidates): 0.93-0.99x the fit, 1.3-1.5x
     the prediction, 0.1 and 0.8 points less on the development halves (three seeds)
-    and 1.0 on the large sets (one).
+    and 1.0-1.8 on the large sets (two seeds).
 
     Parameters
     ----------
