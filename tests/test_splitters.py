@@ -29,28 +29,25 @@ def test_a_tree_alone_is_a_scikit_learn_classifier(estimator, check):
     check(estimator)
 
 
-def _measures(forest):
+def _splits(forest):
+    """Every split of every tree of ``forest``."""
     out = []
     for tree in forest.trees_:
         stack = [tree.root_]
         while stack:
             node = stack.pop()
             if node.split is not None:
-                out.append(node.split.measure)
+                out.append(node.split)
                 stack.extend(node.children)
     return out
 
 
+def _measures(forest):
+    return [split.measure for split in _splits(forest)]
+
+
 def _split_kinds(forest):
-    kinds = set()
-    for tree in forest.trees_:
-        stack = [tree.root_]
-        while stack:
-            node = stack.pop()
-            if node.split is not None:
-                kinds.add(type(node.split).__name__)
-                stack.extend(node.children)
-    return kinds
+    return {type(split).__name__ for split in _splits(forest)}
 
 
 def _bumps(n=80, seed=0):
@@ -282,12 +279,7 @@ def test_shapelet_splits_find_a_local_pattern():
     with the elastic ones they are kept where they split best."""
     from sk_rtw.forest import ShapeletSplitter
 
-    rng = np.random.default_rng(0)
-    X = rng.standard_normal((80, 60))
-    where = rng.integers(0, 50, size=80)
-    y = np.arange(80) % 2
-    for i in np.flatnonzero(y):
-        X[i, where[i] : where[i] + 8] += np.hanning(8) * 6
+    X, y = _bumps()
     alone = RTWProximityForest(n_trees=20, random_state=0, splitters=[ShapeletSplitter()])
     assert alone.fit(X[:40], y[:40]).score(X[40:], y[40:]) >= 0.8
     mixed = RTWProximityForest(n_trees=20, random_state=0,
