@@ -265,6 +265,31 @@ def test_a_split_holds_its_exemplar_series_not_the_training_set():
     assert not [name for name in vars(forest) if "train" in name]
 
 
+def test_a_forest_keeps_the_exemplars_of_its_splits_and_no_other_candidates():
+    """Every tree's store holds exactly the training series its elastic splits hold (not
+    the exemplars of candidates drawn and dropped), and the forest's shared array is
+    their union."""
+    X, y = three_classes(n_per_class=10)
+    forest = RTWProximityForest(n_trees=4, random_state=0).fit(X, y)
+    union = set()
+    for tree in forest.trees_:
+        held = {r: set() for r in tree._stores}
+        stack = [tree.root_]
+        while stack:
+            node = stack.pop()
+            if node.split is not None:
+                stack.extend(node.children)
+                if hasattr(node.split, "sources"):
+                    held[node.split.measure.representation].update(node.split.sources.tolist())
+        for representation, store in tree._stores.items():
+            assert set(store.used.tolist()) == held[representation]
+            union |= {(representation, r) for r in held[representation]}
+    assert union  # elastic splits were kept
+    shared = {(r, int(row)) for r in forest.trees_[0]._stores
+              for row in forest.trees_[0]._stores[r]._rows}  # fmt: skip
+    assert shared == {(r, row) for r, row in union if r in forest.trees_[0]._stores}
+
+
 def test_mean_exemplars_are_averages_with_randomness_of_their_own():
     X, y = three_classes(n_per_class=9)
     forest = RTWProximityForest(n_trees=4, exemplars="mean", random_state=0).fit(X, y)

@@ -183,6 +183,35 @@ def test_a_new_kind_of_split_is_one_class_and_mixes_with_the_elastic_one():
     assert mixed.score(X, y) == 1.0
 
 
+def test_candidates_after_a_perfect_split_are_drawn_not_routed_and_the_forest_is_the_same(
+    monkeypatch,
+):
+    """Once a candidate splits a node perfectly, the later ones only make their random
+    draws (Splitter.skip): the forest is the one grown routing every candidate."""
+    from sk_rtw.forest import ShapeletSplitter
+
+    X, y = _bumps(n=40)
+    skipped = []
+    fast = RTWProximityForest(n_trees=4, random_state=3)
+    for kind in (ElasticSplitter, ShapeletSplitter):
+        original = kind.skip
+
+        def counted(self, node, rng, original=original):
+            skipped.append(type(self).__name__)
+            original(self, node, rng)
+
+        monkeypatch.setattr(kind, "skip", counted)
+    fast.fit(X, y)
+    assert {"ElasticSplitter", "ShapeletSplitter"} <= set(skipped)  # both kinds skipped
+    for kind in (ElasticSplitter, ShapeletSplitter):  # the reference: route every one
+        monkeypatch.setattr(kind, "skip", lambda self, node, rng: self.candidate(node, rng))
+    full = RTWProximityForest(n_trees=4, random_state=3).fit(X, y)
+    assert [t.n_nodes_ for t in fast.trees_] == [t.n_nodes_ for t in full.trees_]
+    assert [str(s) for s in _splits(fast)] == [str(s) for s in _splits(full)]
+    Z, _ = _bumps(n=30, seed=1)
+    np.testing.assert_array_equal(fast.predict_proba(Z), full.predict_proba(Z))
+
+
 @pytest.mark.parametrize(
     ("splitters", "match"),
     [

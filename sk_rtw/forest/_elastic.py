@@ -232,6 +232,12 @@ class NearestExemplarSplit:
             self.measure, self.classes.tolist(), self.sources.tolist(), self.means, self.store,
         )  # fmt: skip
 
+    def adopt(self) -> None:
+        """Mark the training series it holds as exemplars in its store (the tree keeps
+        this split; :func:`~._splitter.adopt`)."""
+        if self.store is not None:
+            self.store.keep(self.sources)
+
     def route(self, series: Mapping[str, PreparedSeries]) -> np.ndarray:
         """The branch of the nearest exemplar of every series (ties to the lowest)."""
         m = self.measure
@@ -368,9 +374,8 @@ class ElasticSplitter(Splitter):
         # one uniform draw per class: rng.choice(m)'s draw, and one call for all classes
         # draws what a call per class draws, in turn (numpy's stream; a test checks it)
         sources = node.member_series[node.member_starts + rng.integers(node.member_counts)]
-        store = node.stores[measure.representation]
-        store.keep(sources)
-        return NearestExemplarSplit(measure, present, sources, store=store)
+        return NearestExemplarSplit(measure, present, sources,
+                                    store=node.stores[measure.representation])  # fmt: skip
 
     def _mean_exemplars(
         self,

@@ -240,6 +240,15 @@ class ShapeletSplitter(Splitter):
         split = ShapeletSplit(shapelet, feature, threshold, bank)
         return split, (values > threshold).astype(np.int64)
 
+    def skip(self, node: NodeSeries, rng: np.random.Generator) -> None:
+        """The draws of :meth:`candidate` alone (its site and feature), no shapelet taken
+        and no series read."""
+        training = node.training
+        lengths, shortest, classmates = self._pool(node)
+        draw_site(rng, training.collections, training.codes, self.representations, lengths,
+                  self.normalised_fraction, node.indices, shortest, classmates)  # fmt: skip
+        rng.integers(len(self.features))
+
     def _shapelet(self, node: NodeSeries, rng: np.random.Generator) -> tuple[
         Shapelet, ShapeletBank | None
     ]:  # fmt: skip

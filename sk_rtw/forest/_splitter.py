@@ -39,6 +39,16 @@ class Split(Protocol):
         ...
 
 
+def adopt(split: Split) -> None:
+    """Tell ``split`` that a tree keeps it: a split that holds training series (an
+    elastic split's exemplars) marks them in its store here (its optional ``adopt``
+    method), so that the fitted tree keeps the exemplars of its splits, not of every
+    candidate drawn."""
+    method = getattr(split, "adopt", None)
+    if method is not None:
+        method()
+
+
 class Splitter(BaseEstimator, ABC):
     """A kind of split and its recipe (the base of :class:`ElasticSplitter` and of the
     kinds to come).
@@ -64,6 +74,15 @@ class Splitter(BaseEstimator, ABC):
     @abstractmethod
     def draw(self, node: NodeSeries, rng: np.random.Generator) -> Split:
         """One candidate split of ``node`` (of a resolved splitter)."""
+
+    def skip(self, node: NodeSeries, rng: np.random.Generator) -> None:
+        """Make the random draws of one candidate at ``node`` and nothing else: what a
+        tree asks for the candidates left once one has split the node perfectly (none
+        can beat it), so that every later node draws what it would have drawn and the
+        tree is the same, for less work. The default draws the candidate
+        (:meth:`draw`) without routing the node's series; a kind whose draw computes
+        more than its random choices overrides it with the draws alone."""
+        self.draw(node, rng)
 
     def candidate(
         self, node: NodeSeries, rng: np.random.Generator

@@ -38,7 +38,7 @@ from ._params import (
     resolve_splitters,
 )
 from ._series import NodeSeries, SeriesSet, SeriesView, TrainingSet, unit_frame
-from ._splitter import Split, Splitter
+from ._splitter import Split, Splitter, adopt
 
 if TYPE_CHECKING:
     from ..manifolds import Manifold
@@ -104,13 +104,21 @@ def best_split(
 ) -> tuple[Split, float, np.ndarray]:
     """Of the candidates every splitter draws at ``node`` (``n_candidates`` each, in the
     splitters' order), the one with the largest Gini gain (the first drawn of equal
-    gains), its gain, and the branch of every series of the node."""
+    gains), its gain, and the branch of every series of the node.
+
+    Once a candidate splits the node perfectly (its gain is the node's impurity: every
+    branch pure), no later one can beat it: those are only drawn
+    (:meth:`Splitter.skip`), not routed, and the tree is the same."""
     best: tuple[Split, float, np.ndarray] | None = None
+    impurity = node.impurity
     for splitter in splitters:
         for _ in range(splitter.n_candidates or 0):
+            if best is not None and best[1] >= impurity:
+                splitter.skip(node, rng)
+                continue
             split, branches = splitter.candidate(node, rng)
             gain = gini_gain(node.codes, branches, split.n_branches, node.n_classes,
-                             node.impurity)  # fmt: skip
+                             impurity)  # fmt: skip
             if best is None or gain > best[1]:
                 best = split, gain, branches
     assert best is not None  # every splitter draws at least one candidate
@@ -254,6 +262,7 @@ class ProximityTree(ClassifierMixin, BaseEstimator):
                 n_leaves += 1
                 continue
             node.split, node.gain = split, gain
+            adopt(split)
             for branch in range(split.n_branches):
                 members = indices[branches == branch]
                 if len(members):
