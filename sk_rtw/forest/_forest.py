@@ -112,7 +112,7 @@ class RTWProximityForest(ClassifierMixin, BaseEstimator):
     Measured (UCR page, one thread, 100 trees, three seeds): on UCR datasets of 16-180
     training series, 0.906-0.925 mean accuracy per half where
     :class:`RTWNearestCentroid` reads 0.85-0.86 (published: Proximity Forest 2.0
-    0.90-0.93, TS-CHIEF 0.92-0.93, MiniRocket 0.92-0.93), 0.758-0.761 on four large
+    0.90-0.93, TS-CHIEF 0.92-0.93, MiniRocket 0.92-0.93), 0.753-0.761 on four large
     training sets (Proximity Forest 2.0 and TS-CHIEF 0.748); fit 0.1 s to 45 s per dataset,
     level with Proximity Forest 2.0's C++ on the same machine (1.01-1.03x over a half,
     1.34x on the large sets), prediction 0.70-0.80x it. A training set of 7,200 short
@@ -120,7 +120,7 @@ class RTWProximityForest(ClassifierMixin, BaseEstimator):
     ``splitters=[ElasticSplitter()]`` is Proximity Forest 2.0's elastic forest alone
     (this forest's default before shapelet candidates): 0.93-0.99x the fit, 1.3-1.5x
     the prediction, 0.1 and 0.8 points less on the development halves (three seeds)
-    and 1.0-1.8 on the large sets (two seeds).
+    and 1.0-1.8 on the large sets (three seeds).
 
     Parameters
     ----------
