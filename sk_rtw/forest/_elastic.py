@@ -363,6 +363,17 @@ class ElasticSplitter(Splitter):
             )  # fmt: skip
         return node.memo[key]
 
+    def skip(self, node: NodeSeries, rng: np.random.Generator) -> None:
+        """The draws of :meth:`draw` alone: the measure, then the exemplars' indices (a
+        mean's subsets, not averaged)."""
+        self.draw_measure(node, rng)
+        if self.exemplars == "mean":
+            for indices in node.members:
+                size = min(self.mean_subset, math.ceil(math.sqrt(len(indices))))
+                rng.choice(indices, size=size, replace=False)
+            return
+        rng.integers(node.member_counts)
+
     def draw(self, node: NodeSeries, rng: np.random.Generator) -> NearestExemplarSplit:
         present, members = node.present, node.members
         measure = self.draw_measure(node, rng)
