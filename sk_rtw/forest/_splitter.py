@@ -7,7 +7,8 @@ candidate :class:`Split` from the node's series (:class:`~._series.NodeSeries`) 
 tree's generator. A split holds what it needs to route (exemplar series prepared, a
 shapelet and its threshold), never indices into the training set, and routes series the
 same way when the tree grows and when it predicts (:meth:`Split.route`). The tree scores
-the candidates by Gini gain and keeps the best; it never asks which kind a split is, so
+the candidates by Gini gain and keeps the best (a split that holds training series marks
+them when it is kept, its optional ``adopt``); it never asks which kind a split is, so
 a new kind is one splitter class and one split class.
 """
 
@@ -54,8 +55,9 @@ class Splitter(BaseEstimator, ABC):
     kinds to come).
 
     A subclass declares its parameters, may leave ``n_candidates`` and
-    ``representation`` as None (then the forest's values apply, :meth:`resolved`), and
-    implements :meth:`draw`.
+    ``representation`` as None (then the forest's values apply, :meth:`resolved`),
+    implements :meth:`draw`, and may override :meth:`skip` with its random draws alone
+    where drawing a candidate computes more than them.
     """
 
     n_candidates: int | None

@@ -4,9 +4,12 @@ A tree is grown from a seed of its own (the forest draws every tree's seed befor
 work, so a forest's result does not depend on how many threads build it). At every node
 each splitter (:mod:`._splitter`) draws its candidates in turn; every candidate routes
 the node's series (:meth:`Split.route`) and is scored by its Gini gain; the first of the
-largest gain is kept. A node whose best split leaves every series in one branch (series
-that no candidate tells apart), or that reaches ``max_depth``, becomes a leaf with its
-class proportions; so does a pure node. A branch that receives no training series (its
+largest gain is kept (once one splits the node perfectly the rest are only drawn, not
+routed: the same tree for less work), and it marks the training series it holds
+(:func:`~._splitter.adopt`), so the fitted tree keeps the exemplars of its splits alone.
+A node whose best split leaves every series in one branch (series that no candidate
+tells apart), or that reaches ``max_depth``, becomes a leaf with its class proportions;
+so does a pure node. A branch that receives no training series (its
 exemplar tied at distance 0 with another class's) is a leaf with its parent's
 proportions. Prediction routes every series down by the same splits; the tree never asks
 which kind a split is.
