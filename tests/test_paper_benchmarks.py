@@ -339,7 +339,9 @@ def test_the_forest_speed_benchmark_records_a_dataset_and_sums_a_half(monkeypatc
     assert 0.5 < record["accuracy"] <= 1.0
     for key in ("fit_cpu", "predict_cpu", "dtw_per_series", "fit_wall_1", "fit_wall_2"):
         assert record[key] > 0
-    assert record["pickle_bytes"] > record["train_bytes"] > 0
+    # both sizes measured (three trees on 67 short series keep fewer exemplars than the
+    # training set holds: the pickle may be the smaller)
+    assert record["pickle_bytes"] > 0 and record["train_bytes"] == 67 * 24 * 8
     published = tmp_path / "published_results.csv"
     published.write_text("dataset,half,PF2_split0,PF2_train_s,PF2_test_s\n"
                          "ItalyPowerDemand,B,0.9679,0.5,2.0\n")  # fmt: skip
