@@ -114,11 +114,11 @@ class RTWProximityForest(ClassifierMixin, BaseEstimator):
     :class:`RTWNearestCentroid` reads 0.85-0.86 (published: Proximity Forest 2.0
     0.90-0.93, TS-CHIEF 0.92-0.93, MiniRocket 0.92-0.93), 0.753-0.761 on four large
     training sets (Proximity Forest 2.0 and TS-CHIEF 0.748); fit 0.1 s to 45 s per dataset,
-    level with Proximity Forest 2.0's C++ on the same machine (1.01-1.03x over a half,
-    1.34x on the large sets), prediction 0.70-0.80x it. A training set of 7,200 short
+    within Proximity Forest 2.0's C++ time on the same machine (0.96-0.97x over a half,
+    1.33x on the large sets), prediction 0.72-0.79x it. A training set of 7,200 short
     series (Crop) takes about 4.5 minutes to fit and 1.3 minutes to predict its 16,800.
     ``splitters=[ElasticSplitter()]`` is Proximity Forest 2.0's elastic forest alone
-    (this forest's default before shapelet candidates): 0.93-0.99x the fit, 1.3-1.5x
+    (this forest's default before shapelet candidates): 0.94-1.01x the fit, 1.4-1.6x
     the prediction, 0.1 and 0.8 points less on the development halves (three seeds)
     and 1.0-1.8 on the large sets (three seeds).
 
