@@ -45,6 +45,17 @@ def test_sklearn_compatible(estimator, check):
     check(estimator)
 
 
+def tree_splits(tree):
+    """Every split of ``tree``, from the root down."""
+    out, stack = [], [tree.root_]
+    while stack:
+        node = stack.pop()
+        if node.split is not None:
+            out.append(node.split)
+            stack.extend(node.children)
+    return out
+
+
 def three_classes(n_per_class=8, length=30, seed=0):
     """Univariate three-class data: warped sine, bump and ramp shapes with noise."""
     rng = np.random.default_rng(seed)
@@ -274,13 +285,9 @@ def test_a_forest_keeps_the_exemplars_of_its_splits_and_no_other_candidates():
     union = set()
     for tree in forest.trees_:
         held = {r: set() for r in tree._stores}
-        stack = [tree.root_]
-        while stack:
-            node = stack.pop()
-            if node.split is not None:
-                stack.extend(node.children)
-                if hasattr(node.split, "sources"):
-                    held[node.split.measure.representation].update(node.split.sources.tolist())
+        for split in tree_splits(tree):
+            if hasattr(split, "sources"):
+                held[split.measure.representation].update(split.sources.tolist())
         for representation, store in tree._stores.items():
             assert set(store.used.tolist()) == held[representation]
             union |= {(representation, r) for r in held[representation]}

@@ -15,7 +15,7 @@ from sk_rtw import ElasticSplitter, RTWProximityForest
 from sk_rtw.forest import ProximityTree, Split, Splitter
 
 from .test_estimators import EXPECTED_FAILURES
-from .test_forest import three_classes
+from .test_forest import three_classes, tree_splits
 
 
 def _expected_failures(estimator):
@@ -31,15 +31,7 @@ def test_a_tree_alone_is_a_scikit_learn_classifier(estimator, check):
 
 def _splits(forest):
     """Every split of every tree of ``forest``."""
-    out = []
-    for tree in forest.trees_:
-        stack = [tree.root_]
-        while stack:
-            node = stack.pop()
-            if node.split is not None:
-                out.append(node.split)
-                stack.extend(node.children)
-    return out
+    return [split for tree in forest.trees_ for split in tree_splits(tree)]
 
 
 def _measures(forest):

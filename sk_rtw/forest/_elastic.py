@@ -368,9 +368,7 @@ class ElasticSplitter(Splitter):
         mean's subsets, not averaged)."""
         self.draw_measure(node, rng)
         if self.exemplars == "mean":
-            for indices in node.members:
-                size = min(self.mean_subset, math.ceil(math.sqrt(len(indices))))
-                rng.choice(indices, size=size, replace=False)
+            self._mean_subsets(rng, node.members)
             return
         rng.integers(node.member_counts)
 
@@ -388,6 +386,17 @@ class ElasticSplitter(Splitter):
         return NearestExemplarSplit(measure, present, sources,
                                     store=node.stores[measure.representation])  # fmt: skip
 
+    def _mean_subsets(
+        self, rng: np.random.Generator, members: list[np.ndarray]
+    ) -> list[np.ndarray]:
+        """The random subset of every class whose mean is its exemplar: about the square
+        root of the class's size, at most ``mean_subset`` series, in the classes' order."""
+        return [
+            rng.choice(indices, size=min(self.mean_subset, math.ceil(math.sqrt(len(indices)))),
+                       replace=False)
+            for indices in members
+        ]  # fmt: skip
+
     def _mean_exemplars(
         self,
         rng: np.random.Generator,
@@ -400,10 +409,8 @@ class ElasticSplitter(Splitter):
         prepared for the search."""
         sources = np.full(len(members), -1, dtype=np.int64)
         series = []
-        for b, indices in enumerate(members):
-            size = min(self.mean_subset, math.ceil(math.sqrt(len(indices))))
-            subset = rng.choice(indices, size=size, replace=False)
-            if size == 1:
+        for b, subset in enumerate(self._mean_subsets(rng, members)):
+            if len(subset) == 1:
                 sources[b] = subset[0]
                 series.append(collection.series(int(subset[0])))
                 continue
