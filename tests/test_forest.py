@@ -19,12 +19,14 @@ from sk_rtw.dtw._kernels import sakoe_chiba_rows
 from sk_rtw.forest import (
     ElasticSplitter,
     Measure,
+    NearestExemplarSplit,
     NodeSeries,
+    ShapeletSplitter,
     TrainingSet,
     gini,
     gini_gain,
 )
-from sk_rtw.forest._tree import best_split
+from sk_rtw.forest._tree import best_split, split_node
 from sk_rtw.manifolds import SPD, Product, Quaternion, Sphere
 from sk_rtw.representations import represent
 from sk_rtw.utils import check_series_collection
@@ -315,6 +317,59 @@ def test_max_depth_stops_the_trees():
     assert np.allclose(forest.predict_proba(X).sum(1), 1.0)
 
 
+def test_a_scoring_sample_of_the_node_or_more_grows_the_same_forest():
+    """Nodes no larger than ``scoring_sample`` draw nothing more: the forest is the one
+    every series scores (None) bit for bit (a sample of 24 leaves the 24-series root
+    alone; of 23 not)."""
+    X, y = three_classes()
+    test, _ = three_classes(seed=5)
+    default = RTWProximityForest(n_trees=6, random_state=2, scoring_sample=None).fit(X, y)
+    same = RTWProximityForest(n_trees=6, random_state=2, scoring_sample=24).fit(X, y)
+
+    def splits(forest):
+        return [(str(s), getattr(s, "sources", np.zeros(0)).tolist())
+                for tree in forest.trees_ for s in tree_splits(tree)]  # fmt: skip
+
+    np.testing.assert_array_equal(same.predict_proba(test), default.predict_proba(test))
+    assert splits(same) == splits(default)
+    sampled = RTWProximityForest(n_trees=6, random_state=2, scoring_sample=23).fit(X, y)
+    assert splits(sampled) != splits(default)
+
+
+def test_a_large_node_keeps_the_best_candidate_of_its_sample_and_routes_every_series():
+    """Above ``scoring_sample`` series, the node's split is :func:`best_split` of a
+    uniform sample of that many (drawn first, from the same generator), and that split
+    routes every series of the node; its gain is the Gini gain over the whole node."""
+    X, _ = three_classes(n_per_class=12)
+    codes = np.repeat([0, 1, 2], 12)
+    training = TrainingSet.build(check_series_collection(X, "euclidean"), ("raw", "velocity"),
+                                 codes, 3)  # fmt: skip
+    splitters = tuple(s.resolved({"n_candidates": 3, "representation": "auto",
+                                  "exemplars": "series"})
+                      for s in (ElasticSplitter(), ShapeletSplitter()))  # fmt: skip
+    indices = np.arange(1, 36)
+    for seed in range(4):
+        node = NodeSeries(training, indices, codes[indices])
+        split, gain, branches = split_node(node, splitters, np.random.default_rng(seed), 10)
+        rng = np.random.default_rng(seed)
+        picked = np.sort(rng.choice(len(indices), size=10, replace=False))
+        sample = NodeSeries(training, indices[picked], codes[indices[picked]])
+        expected, _, _ = best_split(sample, splitters, rng)
+        assert type(split) is type(expected) and str(split) == str(expected)
+        if isinstance(split, NearestExemplarSplit):
+            assert set(split.sources) <= set(indices[picked])  # exemplars from the sample
+            np.testing.assert_array_equal(split.sources, expected.sources)
+        rest = {r: training.prepared[r].take(indices) for r in ("raw", "velocity")}
+        np.testing.assert_array_equal(branches, split.route(rest))
+        assert len(branches) == len(indices)
+        assert gain == gini_gain(codes[indices], branches, split.n_branches, 3)
+        # nodes of at most the sample size: the plain best split, the same draws
+        small = NodeSeries(training, indices[:10], codes[indices[:10]])
+        plain = best_split(small, splitters, np.random.default_rng(seed))
+        kept = split_node(small, splitters, np.random.default_rng(seed), 10)
+        assert str(kept[0]) == str(plain[0]) and kept[1] == plain[1]
+
+
 def test_series_no_measure_tells_apart_make_a_leaf():
     """Identical series of two classes: every exemplar ties with the other class's, so
     the node cannot be split and keeps both classes' proportions."""
@@ -361,6 +416,8 @@ def test_verbose_reports_every_tree(capsys):
         ({"representation": "derivative"}, "representation"),
         ({"exemplars": "medoid"}, "exemplars"),
         ({"max_depth": 0}, "max_depth"),
+        ({"scoring_sample": 1}, "scoring_sample"),
+        ({"scoring_sample": 10.5}, "scoring_sample"),
         ({"n_jobs": 0}, "n_jobs"),
         ({"random_state": "a"}, "random_state"),
     ],

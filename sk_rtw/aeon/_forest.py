@@ -79,6 +79,7 @@ class RTWProximityForestClassifier(DelegatingClassifier):
         representation: str = "auto",
         exemplars: str = "series",
         max_depth: int | None = None,
+        scoring_sample: int | None = 1000,
         n_jobs: int | None = 1,
         random_state: int | np.random.RandomState | np.random.Generator | None = None,
         verbose: bool | int = 0,
@@ -90,6 +91,7 @@ class RTWProximityForestClassifier(DelegatingClassifier):
         self.representation = representation
         self.exemplars = exemplars
         self.max_depth = max_depth
+        self.scoring_sample = scoring_sample
         self.n_jobs = n_jobs
         self.random_state = random_state
         self.verbose = verbose

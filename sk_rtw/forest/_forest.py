@@ -20,6 +20,7 @@ from ._params import (
     MAX_DEPTH,
     N_CANDIDATES,
     REPRESENTATION,
+    SCORING_SAMPLE,
     SPLITTERS,
     representations_read,
 )
@@ -38,8 +39,8 @@ N_TREES = Parameter(
 )
 
 FOREST_PARAMETERS = (
-    MANIFOLD, N_TREES, SPLITTERS, N_CANDIDATES, REPRESENTATION, EXEMPLARS, MAX_DEPTH, N_JOBS,
-    RANDOM_STATE, VERBOSE,
+    MANIFOLD, N_TREES, SPLITTERS, N_CANDIDATES, REPRESENTATION, EXEMPLARS, MAX_DEPTH,
+    SCORING_SAMPLE, N_JOBS, RANDOM_STATE, VERBOSE,
 )  # fmt: skip
 FOREST_DEFAULTS = {
     "manifold": "euclidean",
@@ -49,6 +50,7 @@ FOREST_DEFAULTS = {
     "representation": "auto",
     "exemplars": "series",
     "max_depth": None,
+    "scoring_sample": 1000,
     "n_jobs": None,
     "random_state": None,
     "verbose": 0,
@@ -183,6 +185,7 @@ class RTWProximityForest(ClassifierMixin, BaseEstimator):
         representation: str = "auto",
         exemplars: str = "series",
         max_depth: int | None = None,
+        scoring_sample: int | None = 1000,
         n_jobs: int | None = None,
         random_state: int | np.random.RandomState | np.random.Generator | None = None,
         verbose: bool | int = 0,
@@ -194,6 +197,7 @@ class RTWProximityForest(ClassifierMixin, BaseEstimator):
         self.representation = representation
         self.exemplars = exemplars
         self.max_depth = max_depth
+        self.scoring_sample = scoring_sample
         self.n_jobs = n_jobs
         self.random_state = random_state
         self.verbose = verbose

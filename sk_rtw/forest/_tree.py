@@ -36,6 +36,7 @@ from ._params import (
     MAX_DEPTH,
     N_CANDIDATES,
     REPRESENTATION,
+    SCORING_SAMPLE,
     SPLITTERS,
     representations_read,
     resolve_splitters,
@@ -128,8 +129,31 @@ def best_split(
     return best
 
 
+def split_node(
+    node: NodeSeries,
+    splitters: tuple[Splitter, ...],
+    rng: np.random.Generator,
+    scoring_sample: int | None = None,
+) -> tuple[Split, float, np.ndarray]:
+    """The split of ``node``: :func:`best_split` of its series, or, when it holds more
+    than ``scoring_sample`` series, :func:`best_split` of a random sample of that many
+    (drawn first, uniformly without replacement, in the node's order), whose kept
+    candidate then routes every series of the node. Returns the split, its Gini gain
+    over the whole node and every series' branch."""
+    n = len(node.indices)
+    if scoring_sample is None or n <= scoring_sample:
+        return best_split(node, splitters, rng)
+    picked = np.sort(rng.choice(n, size=scoring_sample, replace=False))
+    sample = NodeSeries(node.training, node.indices[picked], node.codes[picked], node.stores)
+    split, _, _ = best_split(sample, splitters, rng)
+    branches = split.route(node.series)
+    gain = gini_gain(node.codes, branches, split.n_branches, node.n_classes, node.impurity)
+    return split, gain, branches
+
+
 TREE_PARAMETERS = (
-    MANIFOLD, SPLITTERS, N_CANDIDATES, REPRESENTATION, EXEMPLARS, MAX_DEPTH, RANDOM_STATE
+    MANIFOLD, SPLITTERS, N_CANDIDATES, REPRESENTATION, EXEMPLARS, MAX_DEPTH, SCORING_SAMPLE,
+    RANDOM_STATE,
 )  # fmt: skip
 TREE_DEFAULTS = {
     "manifold": "euclidean",
@@ -138,6 +162,7 @@ TREE_DEFAULTS = {
     "representation": "auto",
     "exemplars": "series",
     "max_depth": None,
+    "scoring_sample": 1000,
     "random_state": None,
 }
 
@@ -199,6 +224,7 @@ class ProximityTree(ClassifierMixin, BaseEstimator):
         representation: str = "auto",
         exemplars: str = "series",
         max_depth: int | None = None,
+        scoring_sample: int | None = 1000,
         random_state: int | np.random.RandomState | np.random.Generator | None = None,
     ) -> None:
         self.manifold = manifold
@@ -207,6 +233,7 @@ class ProximityTree(ClassifierMixin, BaseEstimator):
         self.representation = representation
         self.exemplars = exemplars
         self.max_depth = max_depth
+        self.scoring_sample = scoring_sample
         self.random_state = random_state
 
     def fit(self, X: Any, y: Any) -> ProximityTree:
@@ -257,8 +284,9 @@ class ProximityTree(ClassifierMixin, BaseEstimator):
             if pure or (self.max_depth is not None and node.depth >= self.max_depth):
                 n_leaves += 1
                 continue
-            split, gain, branches = best_split(
-                NodeSeries(training, indices, codes[indices], stores), splitters, rng
+            split, gain, branches = split_node(
+                NodeSeries(training, indices, codes[indices], stores), splitters, rng,
+                self.scoring_sample,
             )
             sizes = np.bincount(branches, minlength=split.n_branches)
             if np.count_nonzero(sizes) < 2:  # no candidate told these series apart
