@@ -352,7 +352,9 @@ def test_a_large_node_keeps_the_best_candidate_of_its_sample_and_routes_every_se
         node = NodeSeries(training, indices, codes[indices])
         split, gain, branches = split_node(node, splitters, np.random.default_rng(seed), 10)
         rng = np.random.default_rng(seed)
-        picked = np.sort(rng.choice(len(indices), size=10, replace=False))
+        picked = rng.choice(len(indices), size=10, replace=False)
+        assert set(codes[indices[picked]]) == {0, 1, 2}  # no class to add: the draw alone
+        picked = np.sort(picked)
         sample = NodeSeries(training, indices[picked], codes[indices[picked]])
         expected, _, _ = best_split(sample, splitters, rng)
         assert type(split) is type(expected) and str(split) == str(expected)
@@ -368,6 +370,28 @@ def test_a_large_node_keeps_the_best_candidate_of_its_sample_and_routes_every_se
         plain = best_split(small, splitters, np.random.default_rng(seed))
         kept = split_node(small, splitters, np.random.default_rng(seed), 10)
         assert str(kept[0]) == str(plain[0]) and kept[1] == plain[1]
+
+
+def test_a_class_the_sample_misses_is_added_to_it_and_told_apart():
+    """One series of a second class among 40: a sample of 8 seldom draws it, so one of
+    its series joins every sample that misses it, and every tree still separates the
+    training set into pure leaves (without that, most trees would stop at the root)."""
+    rng = np.random.default_rng(0)
+    X = rng.standard_normal((41, 20)).cumsum(1)
+    y = np.array([0] * 40 + [1])
+    forest = RTWProximityForest(n_trees=10, random_state=0, scoring_sample=8).fit(X, y)
+    assert all(tree.n_nodes_ > 1 for tree in forest.trees_)
+    for tree in forest.trees_:
+        np.testing.assert_array_equal(tree.predict(X), y)
+    training = TrainingSet.build(check_series_collection(X, "euclidean"), ("raw", "velocity"),
+                                 y, 2)  # fmt: skip
+    splitters = (ElasticSplitter().resolved(
+        {"n_candidates": 2, "representation": "auto", "exemplars": "series"}),)  # fmt: skip
+    node = NodeSeries(training, np.arange(41), y)
+    for seed in range(5):
+        split, _, branches = split_node(node, splitters, np.random.default_rng(seed), 8)
+        assert split.n_branches == 2 and 40 in split.sources  # the rare class's exemplar
+        assert branches[40] == np.flatnonzero(split.classes == 1)[0]
 
 
 def test_series_no_measure_tells_apart_make_a_leaf():

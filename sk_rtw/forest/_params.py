@@ -71,7 +71,8 @@ SCORING_SAMPLE = Parameter(
     "scoring_sample",
     (Constant(None, "every series of a node scores every candidate"), Interval(int, 2)),
     "At a node of more training series than this, the candidates are drawn from and "
-    "scored (Gini gain) on a uniform random sample of this many of its series, and the "
+    "scored (Gini gain) on a uniform random sample of this many of its series (and one "
+    "series of every class of the node the draw missed), and the "
     "one kept then routes them all: a large node costs one search of all its series "
     "instead of one per candidate. Nodes of at most this many series are split as "
     "without it, so a forest on a training set of at most this many series is the same "

@@ -136,14 +136,21 @@ def split_node(
     scoring_sample: int | None = None,
 ) -> tuple[Split, float, np.ndarray]:
     """The split of ``node``: :func:`best_split` of its series, or, when it holds more
-    than ``scoring_sample`` series, :func:`best_split` of a random sample of that many
-    (drawn first, uniformly without replacement, in the node's order), whose kept
-    candidate then routes every series of the node. Returns the split, its Gini gain
-    over the whole node and every series' branch."""
+    than ``scoring_sample`` series, :func:`best_split` of a random sample of them, whose
+    kept candidate then routes every series of the node. The sample is drawn first:
+    ``scoring_sample`` series uniformly without replacement, and one more of every class
+    of the node they miss (uniformly among its series, in the classes' order), so that
+    every class of the node can be told apart; it is taken in the node's order. Returns
+    the split, its Gini gain over the whole node and every series' branch."""
     n = len(node.indices)
     if scoring_sample is None or n <= scoring_sample:
         return best_split(node, splitters, rng)
-    picked = np.sort(rng.choice(n, size=scoring_sample, replace=False))
+    picked = rng.choice(n, size=scoring_sample, replace=False)
+    missed = np.setdiff1d(node.present, node.codes[picked])
+    if len(missed):  # a class too rare to be drawn: one of its series all the same
+        extra = [rng.choice(np.flatnonzero(node.codes == c)) for c in missed]
+        picked = np.concatenate((picked, extra))
+    picked = np.sort(picked)
     sample = NodeSeries(node.training, node.indices[picked], node.codes[picked], node.stores)
     split, _, _ = best_split(sample, splitters, rng)
     branches = split.route(node.series)
