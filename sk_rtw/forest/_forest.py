@@ -114,11 +114,12 @@ class RTWProximityForest(ClassifierMixin, BaseEstimator):
     Measured (UCR page, one thread, 100 trees, three seeds): on UCR datasets of 16-180
     training series, 0.906-0.925 mean accuracy per half where
     :class:`RTWNearestCentroid` reads 0.85-0.86 (published: Proximity Forest 2.0
-    0.90-0.93, TS-CHIEF 0.92-0.93, MiniRocket 0.92-0.93), 0.754-0.761 on four large
+    0.90-0.93, TS-CHIEF 0.92-0.93, MiniRocket 0.92-0.93), 0.753-0.760 on four large
     training sets (Proximity Forest 2.0 and TS-CHIEF 0.748); fit 0.1 s to 45 s per dataset,
     within Proximity Forest 2.0's C++ time on the same machine (0.96-0.97x over a half,
-    1.33x on the large sets), prediction 0.72-0.79x it. A training set of 7,200 short
-    series (Crop) takes about 4.5 minutes to fit and 1.3 minutes to predict its 16,800.
+    1.13x on the large sets), prediction 0.68-0.79x it. A training set of 7,200 short
+    series (Crop) takes about 3 minutes to fit and 1.2 minutes to predict its 16,800
+    (nodes of more than ``scoring_sample`` series choose their split on a sample).
     ``splitters=[ElasticSplitter()]`` is Proximity Forest 2.0's elastic forest alone
     (this forest's default before shapelet candidates): 0.94-1.01x the fit, 1.4-1.6x
     the prediction, 0.1 and 0.8 points less on the development halves (three seeds)

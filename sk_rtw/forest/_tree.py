@@ -7,6 +7,8 @@ the node's series (:meth:`Split.route`) and is scored by its Gini gain; the firs
 largest gain is kept (once one splits the node perfectly the rest are only drawn, not
 routed: the same tree for less work), and it marks the training series it holds
 (:func:`~._splitter.adopt`), so the fitted tree keeps the exemplars of its splits alone.
+A node of more than ``scoring_sample`` series draws and scores its candidates on a
+random sample of them (:func:`split_node`) and routes them all by the one kept.
 A node whose best split leaves every series in one branch (series that no candidate
 tells apart), or that reaches ``max_depth``, becomes a leaf with its class proportions;
 so does a pure node. A branch that receives no training series (its
