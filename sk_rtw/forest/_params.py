@@ -76,8 +76,8 @@ SCORING_SAMPLE = Parameter(
     "one kept then routes them all: a large node costs one search of all its series "
     "instead of one per candidate. Nodes of at most this many series are split as "
     "without it, so a forest on a training set of at most this many series is the same "
-    "as with None, bit for bit. The default 1000 cuts the fit of Crop's 7,200 series by "
-    "a quarter at the same accuracy (UCR page).",
+    "as with None, bit for bit. The default 1000 takes the fit of Crop's 7,200 series to "
+    "0.69x, ElectricDevices' 8,926 to 0.78x, at the same accuracy (UCR page).",
 )
 
 
